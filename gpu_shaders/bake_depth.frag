@@ -1,0 +1,5 @@
+/* Depth pre-pass: only the depth attachment matters. */
+void main()
+{
+  dummy_out = 0.0;
+}

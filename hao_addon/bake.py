@@ -1,0 +1,107 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Bake orchestration shared by the operator, the CLI and the tests.
+
+``bake_steps`` is a generator: it yields the fraction done after each light direction, so the
+modal operator can draw progress and stop between directions (cancel), and ``bake`` simply
+drains it. Nothing here touches Blender data: input and output are numpy.
+"""
+from __future__ import annotations
+
+import hashlib
+import time
+from collections import OrderedDict
+from dataclasses import dataclass, field
+from typing import Callable, Generator
+
+import numpy as np
+
+from .core.geometry import TriangleSoup
+from .core.plan import BakeInputError, make_plan
+from .core.seams import finalize_map
+from .core.settings import BakeSettings
+
+
+@dataclass
+class BakeResult:
+    """ao: (size, size) float32 accessibility (1 = open), row 0 at v = 0 (Blender's pixel
+    order); covered: texels with a direct estimate; filled: covered plus margin."""
+
+    ao: np.ndarray
+    covered: np.ndarray
+    filled: np.ndarray
+    stats: dict = field(default_factory=dict)
+
+
+_CACHE: "OrderedDict[str, BakeResult]" = OrderedDict()
+_CACHE_SIZE = 8
+
+
+def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings) -> str:
+    h = hashlib.blake2b(digest_size=20)
+    h.update(repr(settings.cache_key()).encode())
+    for soup in [target, *occluders]:
+        h.update(np.ascontiguousarray(soup.positions).tobytes())
+        h.update(b"|uv|" if soup.uvs is not None else b"|no-uv|")
+        if soup.uvs is not None:
+            h.update(np.ascontiguousarray(soup.uvs).tobytes())
+    return h.hexdigest()
+
+
+def clear_cache() -> None:
+    _CACHE.clear()
+
+
+def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+               use_cache: bool = True) -> Generator[float, None, BakeResult]:
+    """Bake `target` (with UVs) against itself and `occluders`; yields progress in [0, 1].
+
+    A re-bake of identical geometry, UVs and settings returns the cached result at once
+    (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
+    """
+    t0 = time.perf_counter()
+    key = _digest(target, occluders, settings) if use_cache else None
+    if key is not None and key in _CACHE:
+        _CACHE.move_to_end(key)
+        cached = _CACHE[key]
+        yield 1.0
+        return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True})
+
+    plan = make_plan(target, occluders, settings)
+    from .gpu import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
+    baker_cls = baker_for(settings.method)
+    baker_cls.check_limits(plan)
+    baker = baker_cls(plan)
+    try:
+        count = settings.directions
+        for i in range(count):
+            baker.run_direction(i)
+            yield (i + 1) / count
+        numerator, denominator = baker.accumulated()
+        gpu_stats = dict(baker.stats)
+    finally:
+        baker.free()
+    ao, covered, filled = finalize_map(numerator, denominator, settings.margin)
+    stats = {**plan.stats, **gpu_stats, "covered_texels": int(covered.sum()),
+             "seconds": time.perf_counter() - t0, "cache_hit": False}
+    result = BakeResult(ao, covered, filled, stats)
+    if key is not None:
+        _CACHE[key] = result
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.popitem(last=False)
+    return result
+
+
+def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+         progress: Callable[[float], None] | None = None, use_cache: bool = True) -> BakeResult:
+    """Blocking bake (drains bake_steps)."""
+    steps = bake_steps(target, occluders, settings, use_cache)
+    while True:
+        try:
+            fraction = next(steps)
+        except StopIteration as stop:
+            return stop.value
+        if progress is not None:
+            progress(fraction)
+
+
+__all__ = ["BakeInputError", "BakeResult", "bake", "bake_steps", "clear_cache"]

@@ -1,0 +1,84 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Direction sets over the unit sphere for the outside-in baker.
+
+The baker renders the mesh from D directions. McGraw & Sowers draw them at random; a
+spherical Fibonacci set is a low-discrepancy set with equal area per point, so the
+quadrature error of the hemisphere integral shrinks faster than 1/sqrt(D). A seeded random
+rotation removes the set's fixed alignment with the axes (a floor aligned with the poles
+would otherwise see a degenerate pattern) while keeping bakes deterministic.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
+
+
+def fibonacci_sphere(count: int) -> np.ndarray:
+    """Spherical Fibonacci points.
+
+    Returns (count, 3) float64 unit vectors, each the centre of an equal-area cell.
+    """
+    if count < 1:
+        raise ValueError(f"need at least one direction, got {count}")
+    i = np.arange(count, dtype=np.float64)
+    z = 1.0 - (2.0 * i + 1.0) / count
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, 1.0))
+    phi = i * GOLDEN_ANGLE
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def random_rotation(seed: int) -> np.ndarray:
+    """A uniformly random rotation matrix (3, 3) float64 from a seed (QR of a Gaussian)."""
+    rng = np.random.default_rng(seed)
+    q, r = np.linalg.qr(rng.standard_normal((3, 3)))
+    q *= np.sign(np.diag(r))
+    if np.linalg.det(q) < 0.0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+def bake_directions(count: int, seed: int = 0) -> np.ndarray:
+    """The baker's direction set: a randomly rotated spherical Fibonacci set.
+
+    Returns (count, 3) float64 unit vectors pointing from the surface towards the sky.
+    """
+    return fibonacci_sphere(count) @ random_rotation(seed).T
+
+
+def stratified_cosine_hemisphere(count: int, rng: np.random.Generator) -> np.ndarray:
+    """Cosine-weighted directions about +z, stratified on the unit disk.
+
+    A jittered sqrt(count) x sqrt(count) grid on the square is mapped to the disk by the
+    concentric (Shirley-Chiu) map and lifted to the hemisphere (Malley's method), so the
+    pdf is cos(theta)/pi and the estimator of the cosine-weighted visibility is a plain mean.
+    Returns (n, 3) float64 with n = floor(sqrt(count))**2.
+    """
+    side = max(1, int(np.sqrt(count)))
+    gy, gx = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
+    u = (gx.ravel() + rng.random(side * side)) / side * 2.0 - 1.0
+    v = (gy.ravel() + rng.random(side * side)) / side * 2.0 - 1.0
+    # Concentric map: avoids the clumping of the polar map at the centre.
+    use_u = np.abs(u) > np.abs(v)
+    r = np.where(use_u, u, v)
+    safe_u = np.where(u == 0.0, 1.0, u)
+    safe_v = np.where(v == 0.0, 1.0, v)
+    theta = np.where(use_u, (np.pi / 4.0) * (v / safe_u), (np.pi / 2.0) - (np.pi / 4.0) * (u / safe_v))
+    x = r * np.cos(theta)
+    y = r * np.sin(theta)
+    z = np.sqrt(np.clip(1.0 - x * x - y * y, 0.0, 1.0))
+    return np.stack([x, y, z], axis=1)
+
+
+def frame_from_normal(n: np.ndarray) -> np.ndarray:
+    """Orthonormal frames (m, 3, 3) whose third row is the unit normal n (m, 3).
+
+    Uses the branch-free construction of Duff et al. 2017 (no singularity at n = -z).
+    """
+    n = np.asarray(n, dtype=np.float64)
+    sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + sign * n[:, 0] ** 2 * a, sign * b, -sign * n[:, 0]], axis=1)
+    s = np.stack([b, sign + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
+    return np.stack([t, s, n], axis=1)

@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The exact normalization constant of the discrete AO sum (replacing the paper's heuristic).
+
+McGraw & Sowers' equation 8 sums (w_d . n)|J| over the visible texels of every direction d
+and then scale the map so that its brightest texel is 1, assuming some texel is unoccluded.
+That assumption fails on enclosed or contact-heavy meshes and makes values depend on the
+rest of the map. Here each triangle f with unit normal n_f gets the constant
+
+    S_f = sum_d weight(w_d . n_f),   weight(c) = max(c, 0) (cosine) or [c > 0] (uniform),
+
+the value the sum reaches when nothing occludes f. Dividing every contribution of f by S_f
+makes an unoccluded texel exactly 1 for any direction set, and a partly occluded one the
+discrete estimate of the cosine- (or uniformly) weighted visible fraction of its hemisphere.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+WEIGHTINGS = ("cosine", "uniform")
+
+
+def hemisphere_weight(cos_theta: np.ndarray, weighting: str) -> np.ndarray:
+    """Per-direction weight of the estimator for cos(theta) = w . n."""
+    if weighting == "cosine":
+        return np.maximum(cos_theta, 0.0)
+    if weighting == "uniform":
+        return (cos_theta > 0.0).astype(cos_theta.dtype)
+    raise ValueError(f"unknown weighting '{weighting}', expected one of {WEIGHTINGS}")
+
+
+def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str = "cosine",
+                     chunk: int = 65536) -> np.ndarray:
+    """S_f for each face.
+
+    normals: (F, 3) unit face normals (zero rows for degenerate faces);
+    directions: (D, 3) unit directions. Returns (F,) float64; 0 where no direction sees the face.
+    """
+    normals = np.asarray(normals, dtype=np.float64)
+    dirs_t = np.ascontiguousarray(np.asarray(directions, dtype=np.float64).T)
+    out = np.empty(len(normals), dtype=np.float64)
+    for start in range(0, len(normals), chunk):
+        block = normals[start:start + chunk] @ dirs_t  # (chunk, D)
+        out[start:start + chunk] = hemisphere_weight(block, weighting).sum(axis=1)
+    return out

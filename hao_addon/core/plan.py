@@ -1,0 +1,142 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""CPU-side preparation of a bake, shared by both GPU bake variants (pure numpy).
+
+Validates the input, normalizes coordinates (float64 -> float32 near [-1, 1]), computes face
+normals and exact normalizers, culls occluders that cannot matter, and chooses the light-view
+pixel size from the texel density of the UV layout.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .directions import bake_directions
+from .geometry import TriangleSoup, aabb_distance, bounding_sphere, face_normals_areas, uv_areas
+from .normalization import face_normalizers
+from .settings import BakeSettings
+from .views import OrthoView, fit_view
+
+# The light view never exceeds this many pixels per side (GPU limit is checked separately);
+# at 8192^2 one RGBA32F view buffer takes 1 GiB.
+MAX_VIEW_SIDE = 8192
+
+
+class BakeInputError(ValueError):
+    """The input cannot be baked; the message says why in words a user can act on."""
+
+
+@dataclass
+class BakePlan:
+    settings: BakeSettings
+    centre: np.ndarray            # (3,) float64, world
+    scale: float                  # world units per normalized unit
+    target_positions: np.ndarray  # (Ft, 3, 3) float32 normalized
+    target_uvs: np.ndarray        # (Ft, 3, 2) float32
+    target_faces: np.ndarray      # (Ft, 4) float32: unit normal, 1 / S_f (0 if never lit)
+    occluder_positions: np.ndarray  # (Fo, 3, 3) float32 normalized
+    occluder_normals: np.ndarray    # (Fo, 3) float32
+    directions: np.ndarray        # (D, 3) float64
+    pixel_size: float             # light-view pixel side, normalized units
+    max_view_side: int
+    target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
+    drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def max_distance_normalized(self) -> float:
+        return self.settings.max_distance / self.scale
+
+    def view(self, index: int) -> OrthoView:
+        """The light view of direction `index`, with a deterministic sub-pixel jitter."""
+        omega = self.directions[index]
+        jitter = np.random.default_rng((self.settings.seed, index)).random(2)
+        c, r = self.drawn_sphere
+        w = float(omega @ c)
+        proj_w = self.target_points @ omega
+        return fit_view(omega, self.target_points, (float(proj_w.min()), w + r), self.pixel_size,
+                        jitter, self.max_view_side)
+
+
+def _check_finite(soup: TriangleSoup) -> None:
+    if not np.isfinite(soup.positions).all():
+        bad = int((~np.isfinite(soup.positions)).any(axis=(1, 2)).sum())
+        raise BakeInputError(f"'{soup.name}' has {bad} triangles with NaN or infinite vertex positions")
+    if soup.uvs is not None and not np.isfinite(soup.uvs).all():
+        raise BakeInputError(f"'{soup.name}' has NaN or infinite UV coordinates")
+
+
+def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings) -> BakePlan:
+    """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`."""
+    settings = settings.validated()
+    if target.face_count == 0:
+        raise BakeInputError(f"'{target.name}' has no faces to bake")
+    if target.uvs is None:
+        raise BakeInputError(f"'{target.name}' has no UV map")
+    _check_finite(target)
+    for occ in occluders:
+        _check_finite(occ)
+
+    normals, areas = face_normals_areas(target.positions)
+    if not (areas > 0.0).any():
+        raise BakeInputError(f"'{target.name}' has only zero-area faces")
+    uv_area = uv_areas(target.uvs)
+    if not (uv_area > 0.0).any():
+        raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
+
+    # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
+    flat = target.positions.reshape(-1, 3)
+    centre, radius = bounding_sphere(flat)
+    scale = radius if radius > 0.0 else 1.0
+    t_pos = (target.positions - centre) / scale
+
+    # Occluders that cannot reach the target within max_distance are never drawn.
+    lo_t, hi_t = flat.min(axis=0), flat.max(axis=0)
+    occ_parts, culled_objects, culled_faces, drawn_objects = [], 0, 0, 0
+    for occ in occluders:
+        if occ.face_count == 0:
+            continue
+        p = occ.positions
+        if settings.max_distance > 0.0:
+            if aabb_distance(p.reshape(-1, 3).min(0), p.reshape(-1, 3).max(0), lo_t, hi_t) > settings.max_distance:
+                culled_objects += 1
+                culled_faces += occ.face_count
+                continue
+            gap = np.maximum(0.0, np.maximum(p.min(axis=1) - hi_t, lo_t - p.max(axis=1)))
+            near = np.sqrt((gap * gap).sum(axis=1)) <= settings.max_distance
+            culled_faces += int((~near).sum())
+            p = p[near]
+        drawn_objects += 1
+        occ_parts.append((p - centre) / scale)
+    o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
+    o_normals, _ = face_normals_areas(o_pos) if len(o_pos) else (np.zeros((0, 3)), None)
+
+    directions = bake_directions(settings.directions, settings.seed)
+    s_f = face_normalizers(normals, directions, settings.weighting)
+    inv_s = np.where(s_f > 0.0, 1.0 / np.where(s_f > 0.0, s_f, 1.0), 0.0)
+    inv_s[areas <= 0.0] = 0.0  # zero-area faces cover no surface
+
+    # Light-view pixel size from the texel density: world area per texel on each face.
+    size = settings.size
+    useful = (areas > 0.0) & (uv_area > 0.0)
+    texel_world_area = (areas[useful] / scale**2) / (uv_area[useful] * size * size)
+    order = np.argsort(texel_world_area)
+    cum = np.cumsum(areas[useful][order])
+    # The 25th area-percentile face density: three quarters of the surface gets at least
+    # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
+    density = texel_world_area[order][np.searchsorted(cum, 0.25 * cum[-1])]
+    pixel_size = float(np.sqrt(density / settings.view_samples))
+    pixel_size = max(pixel_size, 2.0 / (MAX_VIEW_SIDE - 4))  # the target sphere has diameter 2
+
+    drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
+    drawn_sphere = bounding_sphere(drawn)
+    target_points = np.unique(t_pos.reshape(-1, 3), axis=0) if len(t_pos) < 2_000_000 else t_pos.reshape(-1, 3)
+
+    stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
+                 zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
+                 occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
+                 occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale)
+    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
+                    np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32),
+                    o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
+                    pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere, stats)

@@ -1,0 +1,93 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Procedural test scenes with known AO (pure numpy triangle soups with UVs).
+
+Analytic answers (cosine-weighted accessibility A = 1 - occluded fraction):
+- a lone plane: A = 1 on top.
+- a sphere of radius R resting on a plane: at distance D from the sphere's centre a plane
+  point sees the sphere with form factor (R/D)^2 cos(theta), cos(theta) = R/D, so
+  A = 1 - (R/D)^3.
+- a floor meeting a vertical wall that is infinite within reach: at distance x from the
+  wall, with max distance d (no falloff) the occluded directions map (Malley) to the disk
+  segment y > x/d, so A = 1 - (acos(s) - s sqrt(1 - s^2)) / pi with s = min(x/d, 1);
+  unlimited distance gives A = 1/2.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .geometry import TriangleSoup
+from .kernels import occlusion_weight
+
+
+def grid_plane(size: float, cells: int, z: float = 0.0, uv_lo: float = 0.0, uv_hi: float = 1.0,
+               name: str = "plane") -> TriangleSoup:
+    """Square [-size/2, size/2]^2 at height z facing +z, cells x cells quads, UVs mapped
+    linearly onto [uv_lo, uv_hi]^2."""
+    t = np.linspace(0.0, 1.0, cells + 1)
+    gx, gy = np.meshgrid(t, t, indexing="xy")
+    i, j = np.meshgrid(np.arange(cells), np.arange(cells), indexing="xy")
+    i, j = i.ravel(), j.ravel()
+    corners = lambda di, dj: np.stack([gx[j + dj, i + di], gy[j + dj, i + di]], axis=1)  # noqa: E731
+    a, b, c, d = corners(0, 0), corners(1, 0), corners(1, 1), corners(0, 1)
+    uv = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    xy = (uv - 0.5) * size
+    pos = np.concatenate([xy, np.full(xy.shape[:2] + (1,), z)], axis=2)
+    return TriangleSoup(pos, uv_lo + uv * (uv_hi - uv_lo), name=name)
+
+
+def uv_sphere(radius: float, centre, segments: int = 64, rings: int = 32, name: str = "sphere") -> TriangleSoup:
+    """Closed UV sphere (outward normals, counter-clockwise), UVs equirectangular."""
+    theta = np.linspace(0.0, np.pi, rings + 1)
+    phi = np.linspace(0.0, 2.0 * np.pi, segments + 1)
+    th, ph = np.meshgrid(theta, phi, indexing="ij")
+    pts = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], axis=-1)
+    uvs = np.stack([ph / (2 * np.pi), 1.0 - th / np.pi], axis=-1)
+    tris, tuv = [], []
+    for r in range(rings):
+        for s in range(segments):
+            a, b, c, d = (r, s), (r + 1, s), (r + 1, s + 1), (r, s + 1)
+            for tri in ((a, b, c), (a, c, d)):
+                p = np.array([pts[k] for k in tri])
+                if np.linalg.norm(np.cross(p[1] - p[0], p[2] - p[0])) < 1e-12:
+                    continue  # pole triangles collapse
+                tris.append(p)
+                tuv.append([uvs[k] for k in tri])
+    return TriangleSoup(np.array(tris) * radius + np.asarray(centre, float), np.array(tuv), name=name)
+
+
+def wall(width: float, height: float, x: float, name: str = "wall") -> TriangleSoup:
+    """Vertical rectangle in the plane x = const, facing -x (towards the floor at x < wall),
+    spanning y in [-width/2, width/2], z in [0, height]."""
+    y0, y1 = -width / 2, width / 2
+    a, b, c, d = [x, y0, 0.0], [x, y1, 0.0], [x, y1, height], [x, y0, height]
+    # Counter-clockwise seen from -x: normal (b - a) x (c - a) points to -x.
+    pos = np.array([[a, c, b], [a, d, c]], dtype=float)
+    uv = np.array([[[0, 0], [1, 1], [1, 0]], [[0, 0], [0, 1], [1, 1]]], dtype=float)
+    return TriangleSoup(pos, uv, name=name)
+
+
+def sphere_on_plane_accessibility(distance_to_centre: np.ndarray, radius: float) -> np.ndarray:
+    """A = 1 - (R/D)^3 for plane points at distance D from the resting sphere's centre."""
+    d = np.maximum(np.asarray(distance_to_centre, float), radius)
+    return 1.0 - (radius / d) ** 3
+
+
+def wall_accessibility(distance_to_wall: np.ndarray, max_distance: float, falloff: str = "none",
+                       quadrature: int = 4096) -> np.ndarray:
+    """Floor next to an infinite wall. Exact for falloff 'none'; for 'wendland' the 1D
+    integral over the disk's y coordinate is evaluated by the midpoint rule (error < 1e-6).
+
+    Under Malley's mapping a unit-disk point (X, Y) is the direction with cos(theta) =
+    sqrt(1 - X^2 - Y^2); the ray towards the wall (Y > 0) hits it at t = x / Y, so
+    A = 1 - (1/pi) * integral_0^1 rho(x / Y) * 2 sqrt(1 - Y^2) dY.
+    """
+    x = np.atleast_1d(np.asarray(distance_to_wall, float))
+    if max_distance <= 0.0:
+        return np.full_like(x, 0.5)
+    if falloff == "none":
+        s = np.clip(x / max_distance, 0.0, 1.0)
+        return 1.0 - (np.arccos(s) - s * np.sqrt(1.0 - s * s)) / np.pi
+    y = (np.arange(quadrature) + 0.5) / quadrature
+    chord = 2.0 * np.sqrt(1.0 - y * y)
+    rho = occlusion_weight(x[:, None] / y[None, :], max_distance, falloff)
+    return 1.0 - (rho * chord).sum(axis=1) / quadrature / np.pi

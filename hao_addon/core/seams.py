@@ -1,0 +1,86 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Seam repair and margin (McGraw & Sowers section 3.3), on the normalized AO map.
+
+Erosion drops texels whose UV coverage is too small to trust (on a chart's rim a texel holds
+only a sliver of surface, so its estimate rests on few samples and on the tent's tail);
+dilation then refills them, and grows every chart by `margin` texels, with the mean of the
+valid 8-neighbours, ring by ring, as Cycles' "Extend" margin does. The margin keeps bilinear
+and mip-mapped lookups from reading the background at chart borders.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+MIN_COVERAGE = 0.5
+_OFFSETS = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
+
+
+def _shift(a: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
+    """a shifted so that out[y, x] = a[y + dy, x + dx] (fill outside)."""
+    out = np.full_like(a, fill)
+    h, w = a.shape
+    ys, yd = (slice(dy, h), slice(0, h - dy)) if dy >= 0 else (slice(0, h + dy), slice(-dy, h))
+    xs, xd = (slice(dx, w), slice(0, w - dx)) if dx >= 0 else (slice(0, w + dx), slice(-dx, w))
+    out[yd, xd] = a[ys, xs]
+    return out
+
+
+def dilate(values: np.ndarray, valid: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
+    """Grow the valid region by `rings` texels, each new texel the mean of its valid
+    8-neighbours. values: (H, W) float; valid: (H, W) bool. Returns new (values, valid)."""
+    values = values.astype(np.float32, copy=True)
+    valid = valid.copy()
+    for _ in range(rings):
+        # Work only in the bounding box of the frontier (one texel around the valid set).
+        rows = np.flatnonzero(valid.any(axis=1))
+        cols = np.flatnonzero(valid.any(axis=0))
+        if len(rows) == 0:
+            break
+        y0, y1 = max(rows[0] - 1, 0), min(rows[-1] + 2, valid.shape[0])
+        x0, x1 = max(cols[0] - 1, 0), min(cols[-1] + 2, valid.shape[1])
+        v, m = values[y0:y1, x0:x1], valid[y0:y1, x0:x1]
+        total = np.zeros(v.shape, np.float32)
+        count = np.zeros(v.shape, np.float32)
+        vm = np.where(m, v, 0.0).astype(np.float32)
+        mf = m.astype(np.float32)
+        for dy, dx in _OFFSETS:
+            total += _shift(vm, dy, dx, 0.0)
+            count += _shift(mf, dy, dx, 0.0)
+        grow = (~m) & (count > 0)
+        if not grow.any():
+            break
+        v[grow] = total[grow] / count[grow]
+        m[grow] = True
+    return values, valid
+
+
+def grow_mask(mask: np.ndarray, rings: int) -> np.ndarray:
+    """Binary 8-neighbour dilation of mask (H, W) bool by `rings` texels."""
+    out = mask.copy()
+    for _ in range(rings):
+        grown = out.copy()
+        for dy, dx in _OFFSETS:
+            grown |= _shift(out, dy, dx, False)
+        out = grown
+    return out
+
+
+def finalize_map(numerator: np.ndarray, coverage: np.ndarray, margin: int,
+                 background: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Accessibility map from the accumulated sums.
+
+    numerator: (H, W) float64 visible weight; coverage: (H, W) float64 total weight (the
+    texel's UV coverage, about 1 inside a chart). Returns (ao (H, W) float32 in [0, 1], covered
+    (H, W) bool: texels with a trusted estimate, filled (H, W) bool: every texel a UV
+    triangle touches plus `margin` rings). Texels outside hold `background`.
+    """
+    covered = coverage >= MIN_COVERAGE
+    ratio = np.divide(numerator, coverage, out=np.zeros_like(numerator), where=covered)
+    ao = np.clip(ratio, 0.0, 1.0).astype(np.float32)
+    # Erosion is the MIN_COVERAGE threshold. Dilation refills the eroded rim (at most two
+    # texels wide: the tent reaches one texel past a triangle) and then grows the margin.
+    target = grow_mask(coverage > 0.0, margin)
+    ao, filled = dilate(ao, covered, margin + 2)
+    filled &= target
+    ao = np.where(filled, ao, np.float32(background))
+    return ao, covered, filled

@@ -1,0 +1,183 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""McGraw & Sowers' per-texel AO bake on the GPU: render from D directions, scatter the
+visible texels into a histogram (their equations 7 and 8).
+
+Per direction: (1) a depth pre-pass of target and occluders from the light; (2) the target's
+triangles again, without depth test: every fragment splats its weight (omega . n)|J|/S_f into
+a denominator accumulator, and into a numerator accumulator when it is the visible surface
+(see gpu_shaders/bake_splat.frag). The map is numerator / denominator, an estimator whose
+value for an unoccluded texel is exactly 1 and whose denominator doubles as the texel's UV
+coverage (about 1 inside a chart, less on its rim, 2 where two islands overlap).
+
+Fixed point: a direction adds about (4 / D) * coverage to a texel's denominator, so a chunk of
+C directions adds about 4 C / D. The scale makes a chunk's expected sum 2^26, leaving a factor
+64 below 2^32 for overlapping islands and the tent's ripple. After each chunk both
+accumulators are read into float64 and cleared, so D can grow without overflow, and each
+contribution keeps at least 2^26 * 4 / D * |J| * cos * tent units of precision.
+"""
+from __future__ import annotations
+
+import gpu
+import numpy as np
+
+from ..core.plan import BakePlan
+from . import util
+from .shaders import cached_shader, glsl_source
+
+CHUNK_DIRECTIONS = 64
+# Depth agreement between the two passes (NDC depth in [0, 1]; the depth range spans a few
+# normalized units, so this is ~1e-6 of the scene's radius).
+DEPTH_TOLERANCE = 2.0**-21
+
+
+def _raster_info(fragment: str, uniform: bool) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_bake_{fragment}_iface")
+    iface.smooth('VEC2', "uv_texel")
+    iface.flat('VEC4', "face_data")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC3', "pos")
+    info.vertex_in(1, 'VEC2', "uv")
+    info.vertex_in(2, 'VEC4', "face")
+    info.vertex_out(iface)
+    info.push_constant('MAT4', "view_proj")
+    info.push_constant('VEC4', "omega")
+    info.push_constant('VEC2', "tex_size")
+    info.fragment_out(0, 'FLOAT', "dummy_out")
+    info.vertex_source(glsl_source("bake_raster.vert"))
+    if fragment == "depth":
+        info.fragment_source(glsl_source("bake_depth.frag"))
+        return info
+    info.sampler(0, 'FLOAT_2D', "depth_tex")
+    info.image(0, 'R32UI', 'UINT_2D', "accum_num", qualifiers={'READ', 'WRITE'})
+    info.image(1, 'R32UI', 'UINT_2D', "accum_den", qualifiers={'READ', 'WRITE'})
+    info.push_constant('FLOAT', "fixed_scale")
+    info.push_constant('FLOAT', "depth_tolerance")
+    if uniform:
+        info.define("UNIFORM_WEIGHTING", "1")
+    info.fragment_source("layout(early_fragment_tests) in;\n" + glsl_source("bake_common.glsl", "bake_splat.frag"))
+    return info
+
+
+def depth_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("bake_depth",), lambda: _raster_info("depth", False))
+
+
+def splat_shader(uniform: bool) -> "gpu.types.GPUShader":
+    return cached_shader(("bake_splat", uniform), lambda: _raster_info("splat", uniform))
+
+
+def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
+    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)."""
+    ft, fo = len(plan.target_positions), len(plan.occluder_positions) if with_occluders else 0
+    pos = np.concatenate([plan.target_positions.reshape(-1, 3), plan.occluder_positions[:fo].reshape(-1, 3)])
+    uv = np.concatenate([plan.target_uvs.reshape(-1, 2), np.zeros((3 * fo, 2), np.float32)])
+    occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
+    face = np.concatenate([np.repeat(plan.target_faces, 3, axis=0), np.repeat(occ_face, 3, axis=0)])
+    assert len(pos) == 3 * (ft + fo)
+    return util.make_batch('TRIS', {"pos": ('F32', pos), "uv": ('F32', uv), "face": ('F32', face)})
+
+
+def estimate_bytes(plan: BakePlan) -> int:
+    """GPU memory this pass allocates: two accumulators, the view depth and a dummy colour."""
+    side = plan.max_view_side
+    return plan.settings.size**2 * 8 + side * side * (4 + 4)
+
+
+class ScatterBaker(util.GPUPass):
+    """Owns the accumulators, the light-view targets and the batches of one bake."""
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        util.check_texture_limits(plan.settings.size, plan.max_view_side, estimate_bytes(plan))
+
+    def __init__(self, plan: BakePlan) -> None:
+        super().__init__()
+        self.plan = plan
+        size = plan.settings.size
+        side = plan.max_view_side
+        self.all_batch = plan_batch(plan, with_occluders=True)
+        self.target_batch = plan_batch(plan, with_occluders=False)
+        self.accum_num = gpu.types.GPUTexture((size, size), format='R32UI')
+        self.accum_den = gpu.types.GPUTexture((size, size), format='R32UI')
+        for tex in (self.accum_num, self.accum_den):
+            tex.clear(format='UINT', value=(0,))
+        self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
+        self.dummy = gpu.types.GPUTexture((side, side), format='R8')
+        self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
+        self.splat_fb = gpu.types.GPUFrameBuffer(color_slots=self.dummy)
+        self.depth_prog = depth_shader()
+        self.splat_prog = splat_shader(plan.settings.weighting == "uniform")
+        chunk = min(CHUNK_DIRECTIONS, plan.settings.directions)
+        self.fixed_scale = float(2.0**26 * plan.settings.directions / (4.0 * chunk))
+        self.num = np.zeros((size, size), dtype=np.float64)
+        self.den = np.zeros((size, size), dtype=np.float64)
+        self.pending = 0
+        self.stats = dict(view_pixels=0, directions_done=0)
+
+    def _release(self) -> None:
+        self.all_batch = self.target_batch = None
+        self.accum_num = self.accum_den = self.depth = self.dummy = None
+        self.depth_fb = self.splat_fb = None
+
+    def _set_view(self, shader, view, depth_only: bool = False) -> None:
+        shader.bind()
+        shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
+        if not depth_only:  # the depth program's compiler drops the unused uniforms
+            shader.uniform_float("omega", (*view.omega, 0.0))
+            shader.uniform_float("tex_size", (self.plan.settings.size, self.plan.settings.size))
+
+    def run_direction(self, index: int) -> None:
+        """Render light view `index` and splat its target fragments into the accumulators."""
+        plan = self.plan
+        view = plan.view(index)
+        w, h = view.width, view.height
+        culling = 'BACK' if plan.settings.ignore_back_faces else 'NONE'
+        with util.scoped_state():
+            with self.depth_fb.bind():
+                fb = gpu.state.active_framebuffer_get()
+                gpu.state.viewport_set(0, 0, w, h)
+                gpu.state.scissor_set(0, 0, w, h)
+                gpu.state.scissor_test_set(True)
+                fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                gpu.state.blend_set('NONE')
+                gpu.state.depth_test_set('LESS')
+                gpu.state.depth_mask_set(True)
+                gpu.state.face_culling_set(culling)
+                self._set_view(self.depth_prog, view, depth_only=True)
+                self.all_batch.draw(self.depth_prog)
+            # The depth texture is read by texelFetch below; a draw issues no barrier, but
+            # framebuffer writes are visible to later draws in GL, so none is needed here.
+            with self.splat_fb.bind():
+                gpu.state.viewport_set(0, 0, w, h)
+                gpu.state.depth_test_set('NONE')
+                gpu.state.depth_mask_set(False)
+                gpu.state.face_culling_set(culling)
+                shader = self.splat_prog
+                self._set_view(shader, view)
+                shader.uniform_sampler("depth_tex", self.depth)
+                shader.image("accum_num", self.accum_num)
+                shader.image("accum_den", self.accum_den)
+                shader.uniform_float("fixed_scale", self.fixed_scale)
+                shader.uniform_float("depth_tolerance", DEPTH_TOLERANCE)
+                self.target_batch.draw(shader)
+        self.stats["view_pixels"] += w * h
+        self.stats["directions_done"] += 1
+        self.pending += 1
+        if self.pending >= CHUNK_DIRECTIONS:
+            self.flush()
+
+    def flush(self) -> None:
+        """Move the integer accumulators into the float64 sums and clear them."""
+        if self.pending:
+            # Fragment image atomics are not covered by the framebuffer's implicit ordering;
+            # an empty-work dispatch issues the image/texture-fetch barrier before reading.
+            util.image_barrier()
+            for tex, total in ((self.accum_num, self.num), (self.accum_den, self.den)):
+                total += util.texture_to_numpy(tex, np.uint32).astype(np.float64) / self.fixed_scale
+                tex.clear(format='UINT', value=(0,))
+            self.pending = 0
+
+    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
+        """(numerator, denominator), each (size, size) float64, over the directions so far."""
+        self.flush()
+        return self.num, self.den

@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Create Blender's GPU context in background mode (``blender -b``, ``import bpy``).
+
+In background mode every ``gpu`` call raises ``SystemError`` until the window manager has
+initialised the GPU backend. Blender 4.2 to 5.0 have no ``gpu.init()``; rendering once with a
+throw-away ``RenderEngine`` whose ``bl_use_gpu_context`` is set makes Blender create the
+context (0.05 s, no shader compiled), and it stays alive for the rest of the process.
+In the GUI the context already exists and nothing is done.
+"""
+from __future__ import annotations
+
+import bpy
+import gpu
+
+
+class GPUUnavailableError(RuntimeError):
+    """Raised when no GPU context can be created (no EGL/OpenGL driver)."""
+
+
+def gpu_is_ready() -> bool:
+    """True when ``gpu`` objects can be created in this process."""
+    try:
+        gpu.types.GPUOffScreen(1, 1).free()
+    except SystemError:
+        return False
+    return True
+
+
+class _HaoGPUInitEngine(bpy.types.RenderEngine):
+    bl_idname = "HAO_GPU_INIT_ENGINE"
+    bl_label = "HAO GPU init"
+    bl_use_gpu_context = True
+
+    def render(self, depsgraph):  # noqa: D401 - nothing to draw; the context is the point
+        pass
+
+
+def ensure_gpu_context() -> None:
+    """Make the ``gpu`` module usable, creating a context in background mode if needed.
+
+    Leaves no datablock, scene or registered class behind. Raises GPUUnavailableError with
+    the driver's message when the platform has no OpenGL/EGL.
+    """
+    if gpu_is_ready():
+        return
+    if hasattr(gpu, "init"):  # newer Blender versions expose this directly
+        gpu.init()
+        if gpu_is_ready():
+            return
+    had_render_result = {im.name for im in bpy.data.images if im.type == 'RENDER_RESULT'}
+    bpy.utils.register_class(_HaoGPUInitEngine)
+    scene = bpy.data.scenes.new("__hao_gpu_init")
+    cam_data = bpy.data.cameras.new("__hao_gpu_init")
+    cam = bpy.data.objects.new("__hao_gpu_init", cam_data)
+    try:
+        scene.collection.objects.link(cam)
+        scene.camera = cam
+        scene.render.engine = _HaoGPUInitEngine.bl_idname
+        scene.render.resolution_x = scene.render.resolution_y = 8
+        scene.render.resolution_percentage = 100
+        bpy.ops.render.render(scene=scene.name)
+    except RuntimeError as exc:
+        raise GPUUnavailableError(f"could not create a GPU context: {exc}") from exc
+    finally:
+        bpy.data.objects.remove(cam)
+        bpy.data.cameras.remove(cam_data)
+        bpy.data.scenes.remove(scene)
+        bpy.utils.unregister_class(_HaoGPUInitEngine)
+        for im in [i for i in bpy.data.images if i.type == 'RENDER_RESULT']:
+            if im.name not in had_render_result:
+                bpy.data.images.remove(im)
+    if not gpu_is_ready():
+        raise GPUUnavailableError(
+            "no GPU context: install an OpenGL 4.3+ driver (on headless Linux: "
+            "libegl1 libegl-mesa0 libgl1-mesa-dri)")

@@ -1,0 +1,153 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Small helpers around Blender's ``gpu`` module: uploads, readback, state scoping, counting.
+
+Traps handled here (see the probe report): ``attr_fill`` and ``Buffer`` reinterpret any dtype
+silently, so everything is made contiguous float32/int32 first; ``np.asarray(Buffer)`` is a
+transposed view, so readback flattens the Buffer and uses ``np.frombuffer``.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+from typing import Iterator
+
+import gpu
+import numpy as np
+
+# Live GPU-owning pass objects, so tests can check that every bake freed what it made.
+_LIVE_PASSES: set[int] = set()
+
+
+def live_pass_count() -> int:
+    return len(_LIVE_PASSES)
+
+
+class GPUPass:
+    """Base of the passes: registers itself while it holds GPU resources."""
+
+    def __init__(self) -> None:
+        _LIVE_PASSES.add(id(self))
+        self._freed = False
+
+    def free(self) -> None:
+        """Drop every GPU object this pass owns (textures and batches die with their last
+        Python reference: the 4.2-5.0 API has no explicit free for them)."""
+        if not self._freed:
+            self._release()
+            self._freed = True
+            _LIVE_PASSES.discard(id(self))
+
+    def _release(self) -> None:  # overridden
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.free()
+
+
+# Refuse bakes whose textures would exceed this (bytes); the gpu module cannot query free
+# video memory, so the budget is a setting (environment HAO_GPU_MEMORY_BUDGET, in MiB).
+def gpu_memory_budget() -> int:
+    return int(float(os.environ.get("HAO_GPU_MEMORY_BUDGET", "4096")) * 2**20)
+
+
+def check_texture_limits(map_size: int, view_side: int, bytes_needed: int) -> None:
+    """Raise BakeInputError when a bake exceeds the GPU's texture size or the memory budget."""
+    from ..core.plan import BakeInputError
+    limit = gpu.capabilities.max_texture_size_get()
+    if map_size > limit:
+        raise BakeInputError(f"map size {map_size} exceeds this GPU's texture limit of {limit}")
+    if view_side > limit:
+        raise BakeInputError(f"the light views need {view_side} pixels per side, above this GPU's "
+                             f"limit of {limit}: lower the view samples per texel or the map size")
+    budget = gpu_memory_budget()
+    if bytes_needed > budget:
+        raise BakeInputError(f"the bake needs about {bytes_needed / 2**20:.0f} MiB of GPU memory, above the "
+                             f"budget of {budget / 2**20:.0f} MiB (set HAO_GPU_MEMORY_BUDGET to raise it)")
+
+
+def float_attr(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float32)
+
+
+def make_batch(prim: str, attrs: dict[str, tuple[str, np.ndarray]]) -> "gpu.types.GPUBatch":
+    """Batch from numpy arrays. attrs: name -> ('F32', (n, k) array); converted to float32."""
+    fmt = gpu.types.GPUVertFormat()
+    arrays = {}
+    count = None
+    for name, (comp, arr) in attrs.items():
+        arr = float_attr(arr)
+        arrays[name] = arr
+        fmt.attr_add(id=name, comp_type=comp, len=1 if arr.ndim == 1 else arr.shape[1], fetch_mode='FLOAT')
+        count = arr.shape[0]
+    vbo = gpu.types.GPUVertBuf(fmt, count)
+    for name, arr in arrays.items():
+        vbo.attr_fill(id=name, data=arr)
+    return gpu.types.GPUBatch(type=prim, buf=vbo)
+
+
+def texture_to_numpy(tex: "gpu.types.GPUTexture", dtype=np.float32) -> np.ndarray:
+    """Read a 2D texture into a (height, width[, channels]) numpy array (a copy)."""
+    buf = tex.read()
+    shape = tuple(buf.dimensions)
+    n = 1
+    for d in shape:
+        n *= d
+    buf.dimensions = n
+    arr = np.frombuffer(buf, dtype=dtype).reshape(shape)
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[:, :, 0]
+    return arr.copy()
+
+
+
+
+def image_barrier() -> None:
+    """Make image writes of earlier draws visible to later reads. gpu.compute.dispatch()
+    issues GPU_memory_barrier(TEXTURE_FETCH | SHADER_IMAGE_ACCESS) after it runs; draws issue
+    none, so a 1x1x1 dispatch of an empty kernel supplies the missing glMemoryBarrier."""
+    from .shaders import cached_shader
+
+    def build():
+        info = gpu.types.GPUShaderCreateInfo()
+        info.local_group_size(1, 1, 1)
+        info.compute_source("void main() {}")
+        return info
+    shader = cached_shader(("barrier",), build)
+    gpu.compute.dispatch(shader, 1, 1, 1)
+    gpu.shader.unbind()
+
+
+def sync(tex: "gpu.types.GPUTexture") -> None:
+    """Block until queued GPU work is done (there is no gpu.finish): read one texel."""
+    with gpu.types.GPUFrameBuffer(color_slots=tex).bind():
+        gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 1, 0, 'FLOAT')
+
+
+@contextlib.contextmanager
+def scoped_state() -> Iterator[None]:
+    """Restore the drawing state a pass may change: blend, depth test, depth write,
+    viewport; face culling and the scissor test have no getters and return to Blender's
+    defaults (off), which is what Blender's own draw code expects between passes."""
+    blend = gpu.state.blend_get()
+    depth_test = gpu.state.depth_test_get()
+    depth_mask = gpu.state.depth_mask_get()
+    viewport = gpu.state.viewport_get()
+    try:
+        yield
+    finally:
+        gpu.state.blend_set(blend)
+        gpu.state.depth_test_set(depth_test)
+        gpu.state.depth_mask_set(depth_mask)
+        gpu.state.face_culling_set('NONE')
+        gpu.state.scissor_test_set(False)
+        gpu.state.viewport_set(*viewport)
+        gpu.shader.unbind()
+
+
+def snapshot_state() -> tuple:
+    """What scoped_state restores, for tests that check a pass left no state behind."""
+    return (gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get(),
+            tuple(gpu.state.viewport_get()))
