@@ -131,7 +131,11 @@ class ScatterBaker(util.GPUPass):
         plan = self.plan
         view = plan.view(index)
         w, h = view.width, view.height
-        culling = 'BACK' if plan.settings.ignore_back_faces else 'NONE'
+        # Ignoring back faces: a ray from a texel towards the light meets the back of a face
+        # exactly when that face looks towards the light, i.e. faces the light camera. So the
+        # depth pre-pass culls FRONT faces; the splat pass draws only light-facing target
+        # faces and culls nothing.
+        culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
         with util.scoped_state():
             with self.depth_fb.bind():
                 fb = gpu.state.active_framebuffer_get()
@@ -151,7 +155,7 @@ class ScatterBaker(util.GPUPass):
                 gpu.state.viewport_set(0, 0, w, h)
                 gpu.state.depth_test_set('NONE')
                 gpu.state.depth_mask_set(False)
-                gpu.state.face_culling_set(culling)
+                gpu.state.face_culling_set('NONE')
                 shader = self.splat_prog
                 self._set_view(shader, view)
                 shader.uniform_sampler("depth_tex", self.depth)
