@@ -23,11 +23,38 @@ void main()
 #else
   float weight = jacobian * cos_theta * face_data.w;
 #endif
+#ifdef MAX_DISTANCE
+  /* The nearest occluder in front of this fragment: the largest listed depth below its own
+   * (its own entry is equal and excluded by the tolerance). Depth is linear in an
+   * orthographic view, so depth differences times depth_span are distances. */
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  int count = min(int(imageLoad(layer_count, px).r), LAYERS);
+  float z_self = gl_FragCoord.z;
+  float z_front = -1.0;
+  for (int i = 0; i < count; i++) {
+    float z = uintBitsToFloat(imageLoad(layer_depth, ivec3(px, i)).r);
+    if (z < z_self - depth_tolerance && z > z_front) {
+      z_front = z;
+    }
+  }
+  float visible = 1.0;
+  if (z_front >= 0.0) {
+    float t = (z_self - z_front) * depth_span;
+    float x = clamp(t / max_distance, 0.0, 1.0);
+#  ifdef WENDLAND_FALLOFF
+    /* Hybrid AO paper, equation 3. */
+    visible = 1.0 - pow(1.0 - x, 4.0) * (4.0 * x + 1.0);
+#  else
+    visible = (t < max_distance) ? 0.0 : 1.0;
+#  endif
+  }
+#else
   /* Visible: this fragment is the nearest surface. Both passes run the same vertex shader,
    * so the depths agree to the last bit on conforming drivers; the tolerance only absorbs
    * drivers that reassociate arithmetic between programs. */
   float nearest = texelFetch(depth_tex, ivec2(gl_FragCoord.xy), 0).r;
   float visible = (gl_FragCoord.z <= nearest + depth_tolerance) ? 1.0 : 0.0;
+#endif
   splat_bilinear(uv_texel, weight * visible, weight);
   dummy_out = 0.0;
 }

@@ -28,10 +28,13 @@ CHUNK_DIRECTIONS = 64
 # Depth agreement between the two passes (NDC depth in [0, 1]; the depth range spans a few
 # normalized units, so this is ~1e-6 of the scene's radius).
 DEPTH_TOLERANCE = 2.0**-21
+# Depth layers kept per light-view pixel for max-distance bakes. A ray through a closed mesh
+# crosses an even number of surfaces; 16 holds eight nested shells. Overflow is counted.
+LAYERS = 16
 
 
-def _raster_info(fragment: str, uniform: bool) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo(f"hao_bake_{fragment}_iface")
+def _base_info(name: str) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_bake_{name}_iface")
     iface.smooth('VEC2', "uv_texel")
     iface.flat('VEC4', "face_data")
     info = gpu.types.GPUShaderCreateInfo()
@@ -44,14 +47,42 @@ def _raster_info(fragment: str, uniform: bool) -> "gpu.types.GPUShaderCreateInfo
     info.push_constant('VEC2', "tex_size")
     info.fragment_out(0, 'FLOAT', "dummy_out")
     info.vertex_source(glsl_source("bake_raster.vert"))
-    if fragment == "depth":
-        info.fragment_source(glsl_source("bake_depth.frag"))
-        return info
-    info.sampler(0, 'FLOAT_2D', "depth_tex")
+    return info
+
+
+def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = _base_info("depth")
+    info.fragment_source(glsl_source("bake_depth.frag"))
+    return info
+
+
+def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = _base_info("layers")
+    info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
+    info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+    info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
+    info.define("LAYERS", str(LAYERS))
+    info.fragment_source(glsl_source("bake_layers.frag"))
+    return info
+
+
+def _splat_info(uniform: bool, layered: bool, wendland: bool) -> "gpu.types.GPUShaderCreateInfo":
+    info = _base_info("splat")
     info.image(0, 'R32UI', 'UINT_2D', "accum_num", qualifiers={'READ', 'WRITE'})
     info.image(1, 'R32UI', 'UINT_2D', "accum_den", qualifiers={'READ', 'WRITE'})
     info.push_constant('FLOAT', "fixed_scale")
     info.push_constant('FLOAT', "depth_tolerance")
+    if layered:
+        info.image(2, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
+        info.image(3, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+        info.push_constant('FLOAT', "depth_span")
+        info.push_constant('FLOAT', "max_distance")
+        info.define("MAX_DISTANCE", "1")
+        info.define("LAYERS", str(LAYERS))
+        if wendland:
+            info.define("WENDLAND_FALLOFF", "1")
+    else:
+        info.sampler(0, 'FLOAT_2D', "depth_tex")
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
     info.fragment_source("layout(early_fragment_tests) in;\n" + glsl_source("bake_common.glsl", "bake_splat.frag"))
@@ -59,11 +90,15 @@ def _raster_info(fragment: str, uniform: bool) -> "gpu.types.GPUShaderCreateInfo
 
 
 def depth_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("bake_depth",), lambda: _raster_info("depth", False))
+    return cached_shader(("bake_depth",), _depth_info)
 
 
-def splat_shader(uniform: bool) -> "gpu.types.GPUShader":
-    return cached_shader(("bake_splat", uniform), lambda: _raster_info("splat", uniform))
+def layers_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("bake_layers", LAYERS), _layers_info)
+
+
+def splat_shader(uniform: bool, layered: bool, wendland: bool) -> "gpu.types.GPUShader":
+    return cached_shader(("bake_splat", uniform, layered, wendland), lambda: _splat_info(uniform, layered, wendland))
 
 
 def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
@@ -78,9 +113,12 @@ def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
 
 
 def estimate_bytes(plan: BakePlan) -> int:
-    """GPU memory this pass allocates: two accumulators, the view depth and a dummy colour."""
+    """GPU memory this pass allocates: two accumulators, the view depth and a dummy colour,
+    and for max-distance bakes the per-pixel layer lists."""
     side = plan.max_view_side
-    return plan.settings.size**2 * 8 + side * side * (4 + 4)
+    layered = plan.settings.max_distance > 0.0
+    per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
+    return plan.settings.size**2 * 8 + side * side * per_pixel
 
 
 class ScatterBaker(util.GPUPass):
@@ -93,36 +131,49 @@ class ScatterBaker(util.GPUPass):
     def __init__(self, plan: BakePlan) -> None:
         super().__init__()
         self.plan = plan
-        size = plan.settings.size
+        settings = plan.settings
+        size = settings.size
         side = plan.max_view_side
+        self.layered = settings.max_distance > 0.0
         self.all_batch = plan_batch(plan, with_occluders=True)
         self.target_batch = plan_batch(plan, with_occluders=False)
         self.accum_num = gpu.types.GPUTexture((size, size), format='R32UI')
         self.accum_den = gpu.types.GPUTexture((size, size), format='R32UI')
         for tex in (self.accum_num, self.accum_den):
             tex.clear(format='UINT', value=(0,))
-        self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
-        self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
         self.splat_fb = gpu.types.GPUFrameBuffer(color_slots=self.dummy)
-        self.depth_prog = depth_shader()
-        self.splat_prog = splat_shader(plan.settings.weighting == "uniform")
-        chunk = min(CHUNK_DIRECTIONS, plan.settings.directions)
-        self.fixed_scale = float(2.0**26 * plan.settings.directions / (4.0 * chunk))
+        if self.layered:
+            # Skip what the scene does not need: only max-distance bakes pay for layer lists.
+            self.layer_count = gpu.types.GPUTexture((side, side), format='R32UI')
+            self.layer_depth = gpu.types.GPUTexture((side, side, LAYERS), format='R32UI')
+            self.overflow = gpu.types.GPUTexture((1, 1), format='R32UI')
+            self.overflow.clear(format='UINT', value=(0,))
+            self.prepass_prog = layers_shader()
+            self.depth = self.depth_fb = None
+        else:
+            self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
+            self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
+            self.prepass_prog = depth_shader()
+            self.layer_count = self.layer_depth = self.overflow = None
+        self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered, settings.falloff == "wendland")
+        chunk = min(CHUNK_DIRECTIONS, settings.directions)
+        self.fixed_scale = float(2.0**26 * settings.directions / (4.0 * chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
         self.den = np.zeros((size, size), dtype=np.float64)
         self.pending = 0
-        self.stats = dict(view_pixels=0, directions_done=0)
+        self.stats = dict(view_pixels=0, directions_done=0, layered=self.layered, layer_overflow_pixels=0)
 
     def _release(self) -> None:
         self.all_batch = self.target_batch = None
         self.accum_num = self.accum_den = self.depth = self.dummy = None
+        self.layer_count = self.layer_depth = self.overflow = None
         self.depth_fb = self.splat_fb = None
 
-    def _set_view(self, shader, view, depth_only: bool = False) -> None:
+    def _set_view(self, shader, view, prepass: bool = False) -> None:
         shader.bind()
         shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
-        if not depth_only:  # the depth program's compiler drops the unused uniforms
+        if not prepass:  # the pre-pass programs' compilers drop the unused uniforms
             shader.uniform_float("omega", (*view.omega, 0.0))
             shader.uniform_float("tex_size", (self.plan.settings.size, self.plan.settings.size))
 
@@ -133,24 +184,38 @@ class ScatterBaker(util.GPUPass):
         w, h = view.width, view.height
         # Ignoring back faces: a ray from a texel towards the light meets the back of a face
         # exactly when that face looks towards the light, i.e. faces the light camera. So the
-        # depth pre-pass culls FRONT faces; the splat pass draws only light-facing target
-        # faces and culls nothing.
+        # pre-pass culls FRONT faces; the splat pass draws only light-facing target faces and
+        # culls nothing.
         culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
         with util.scoped_state():
-            with self.depth_fb.bind():
-                fb = gpu.state.active_framebuffer_get()
-                gpu.state.viewport_set(0, 0, w, h)
-                gpu.state.scissor_set(0, 0, w, h)
-                gpu.state.scissor_test_set(True)
-                fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-                gpu.state.blend_set('NONE')
-                gpu.state.depth_test_set('LESS')
-                gpu.state.depth_mask_set(True)
-                gpu.state.face_culling_set(culling)
-                self._set_view(self.depth_prog, view, depth_only=True)
-                self.all_batch.draw(self.depth_prog)
-            # The depth texture is read by texelFetch below; a draw issues no barrier, but
-            # framebuffer writes are visible to later draws in GL, so none is needed here.
+            gpu.state.blend_set('NONE')
+            if self.layered:
+                self.layer_count.clear(format='UINT', value=(0,))
+                with self.splat_fb.bind():
+                    gpu.state.viewport_set(0, 0, w, h)
+                    gpu.state.depth_test_set('NONE')
+                    gpu.state.depth_mask_set(False)
+                    gpu.state.face_culling_set(culling)
+                    shader = self.prepass_prog
+                    self._set_view(shader, view, prepass=True)
+                    shader.image("layer_count", self.layer_count)
+                    shader.image("layer_depth", self.layer_depth)
+                    shader.image("overflow", self.overflow)
+                    self.all_batch.draw(shader)
+                util.image_barrier()  # the splat pass reads the lists with imageLoad
+            else:
+                with self.depth_fb.bind():
+                    fb = gpu.state.active_framebuffer_get()
+                    gpu.state.viewport_set(0, 0, w, h)
+                    gpu.state.scissor_set(0, 0, w, h)
+                    gpu.state.scissor_test_set(True)
+                    fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                    gpu.state.scissor_test_set(False)
+                    gpu.state.depth_test_set('LESS')
+                    gpu.state.depth_mask_set(True)
+                    gpu.state.face_culling_set(culling)
+                    self._set_view(self.prepass_prog, view, prepass=True)
+                    self.all_batch.draw(self.prepass_prog)
             with self.splat_fb.bind():
                 gpu.state.viewport_set(0, 0, w, h)
                 gpu.state.depth_test_set('NONE')
@@ -158,11 +223,17 @@ class ScatterBaker(util.GPUPass):
                 gpu.state.face_culling_set('NONE')
                 shader = self.splat_prog
                 self._set_view(shader, view)
-                shader.uniform_sampler("depth_tex", self.depth)
                 shader.image("accum_num", self.accum_num)
                 shader.image("accum_den", self.accum_den)
                 shader.uniform_float("fixed_scale", self.fixed_scale)
                 shader.uniform_float("depth_tolerance", DEPTH_TOLERANCE)
+                if self.layered:
+                    shader.image("layer_count", self.layer_count)
+                    shader.image("layer_depth", self.layer_depth)
+                    shader.uniform_float("depth_span", view.depth_far - view.depth_near)
+                    shader.uniform_float("max_distance", plan.max_distance_normalized)
+                else:
+                    shader.uniform_sampler("depth_tex", self.depth)
                 self.target_batch.draw(shader)
         self.stats["view_pixels"] += w * h
         self.stats["directions_done"] += 1
@@ -173,12 +244,14 @@ class ScatterBaker(util.GPUPass):
     def flush(self) -> None:
         """Move the integer accumulators into the float64 sums and clear them."""
         if self.pending:
-            # Fragment image atomics are not covered by the framebuffer's implicit ordering;
-            # an empty-work dispatch issues the image/texture-fetch barrier before reading.
+            # Fragment image atomics are not ordered with later reads by the framebuffer
+            # rules; an empty dispatch issues the image/texture-fetch barrier first.
             util.image_barrier()
             for tex, total in ((self.accum_num, self.num), (self.accum_den, self.den)):
                 total += util.texture_to_numpy(tex, np.uint32).astype(np.float64) / self.fixed_scale
                 tex.clear(format='UINT', value=(0,))
+            if self.layered:
+                self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
             self.pending = 0
 
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,125 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The shadow-map gather baseline that McGraw & Sowers compare against (their Table 1, ATI's
+GPU MeshMapper): per direction render a depth map from the light, then rasterize the target
+in UV space and test every texel centre against it.
+
+Same interface as ScatterBaker. Differences a user sees: one sample per texel centre (no
+area average, no stretch correction needed), shadow-map bias (a slope-scaled offset can hide
+contact occlusion thinner than a few light-view pixels), and unlimited distance only.
+Sums use ADDITIVE_PREMULT blending into RG32F, exact and order-deterministic.
+"""
+from __future__ import annotations
+
+import gpu
+import numpy as np
+
+from ..core.plan import BakePlan
+from . import util
+from .bake_scatter import depth_shader, plan_batch
+from .shaders import cached_shader, glsl_source
+
+
+def _gather_info(uniform: bool) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo("hao_bake_gather_iface")
+    iface.smooth('VEC3', "light_pos")
+    iface.flat('VEC4', "face_data")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC3', "pos")
+    info.vertex_in(1, 'VEC2', "uv")
+    info.vertex_in(2, 'VEC4', "face")
+    info.vertex_out(iface)
+    info.push_constant('MAT4', "view_proj")
+    info.push_constant('VEC4', "omega")
+    info.push_constant('VEC2', "tex_size")
+    info.push_constant('IVEC2', "view_size")
+    info.push_constant('FLOAT', "pixel_depth")
+    info.sampler(0, 'FLOAT_2D', "depth_tex")
+    info.fragment_out(0, 'VEC4', "gather_out")
+    if uniform:
+        info.define("UNIFORM_WEIGHTING", "1")
+    info.vertex_source(glsl_source("bake_gather.vert"))
+    info.fragment_source(glsl_source("bake_gather.frag"))
+    return info
+
+
+def gather_shader(uniform: bool) -> "gpu.types.GPUShader":
+    return cached_shader(("bake_gather", uniform), lambda: _gather_info(uniform))
+
+
+def estimate_bytes(plan: BakePlan) -> int:
+    side = plan.max_view_side
+    return plan.settings.size**2 * 16 + side * side * 8
+
+
+class GatherBaker(util.GPUPass):
+    """Owns the depth map, the UV-space accumulation target and the batches of one bake."""
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        util.check_texture_limits(plan.settings.size, plan.max_view_side, estimate_bytes(plan))
+
+    def __init__(self, plan: BakePlan) -> None:
+        super().__init__()
+        if plan.settings.max_distance > 0.0:
+            raise ValueError("the gather baseline supports only unlimited distance")
+        self.plan = plan
+        size, side = plan.settings.size, plan.max_view_side
+        self.all_batch = plan_batch(plan, with_occluders=True)
+        self.target_batch = plan_batch(plan, with_occluders=False)
+        self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
+        self.dummy = gpu.types.GPUTexture((side, side), format='R8')
+        self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
+        self.accum = gpu.types.GPUTexture((size, size), format='RGBA32F')
+        self.accum_fb = gpu.types.GPUFrameBuffer(color_slots=self.accum)
+        with self.accum_fb.bind():
+            gpu.state.active_framebuffer_get().clear(color=(0.0, 0.0, 0.0, 0.0))
+        self.depth_prog = depth_shader()
+        self.gather_prog = gather_shader(plan.settings.weighting == "uniform")
+        self.stats = dict(view_pixels=0, directions_done=0, uv_fragments_per_direction=size * size)
+
+    def _release(self) -> None:
+        self.all_batch = self.target_batch = self.depth = self.dummy = None
+        self.depth_fb = self.accum = self.accum_fb = None
+
+    def run_direction(self, index: int) -> None:
+        plan = self.plan
+        view = plan.view(index)
+        w, h = view.width, view.height
+        size = plan.settings.size
+        culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
+        with util.scoped_state():
+            gpu.state.blend_set('NONE')
+            with self.depth_fb.bind():
+                fb = gpu.state.active_framebuffer_get()
+                gpu.state.viewport_set(0, 0, w, h)
+                gpu.state.scissor_set(0, 0, w, h)
+                gpu.state.scissor_test_set(True)
+                fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                gpu.state.scissor_test_set(False)
+                gpu.state.depth_test_set('LESS')
+                gpu.state.depth_mask_set(True)
+                gpu.state.face_culling_set(culling)
+                self.depth_prog.bind()
+                self.depth_prog.uniform_float("view_proj", view.matrix.T.ravel())
+                self.all_batch.draw(self.depth_prog)
+            with self.accum_fb.bind():
+                gpu.state.viewport_set(0, 0, size, size)
+                gpu.state.depth_test_set('NONE')
+                gpu.state.depth_mask_set(False)
+                gpu.state.face_culling_set('NONE')
+                gpu.state.blend_set('ADDITIVE_PREMULT')  # exact ONE, ONE sums
+                shader = self.gather_prog
+                shader.bind()
+                shader.uniform_float("view_proj", view.matrix.T.ravel())
+                shader.uniform_float("omega", (*view.omega, 0.0))
+                shader.uniform_float("tex_size", (size, size))
+                shader.uniform_int("view_size", (w, h))
+                shader.uniform_float("pixel_depth", view.pixel_size / (view.depth_far - view.depth_near))
+                shader.uniform_sampler("depth_tex", self.depth)
+                self.target_batch.draw(shader)
+        self.stats["view_pixels"] += w * h
+        self.stats["directions_done"] += 1
+
+    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
+        rgba = util.texture_to_numpy(self.accum, np.float32).astype(np.float64)
+        return rgba[:, :, 0], rgba[:, :, 1]
