@@ -20,6 +20,15 @@ from .views import OrthoView, fit_view
 # The light view never exceeds this many pixels per side (GPU limit is checked separately);
 # at 8192^2 one RGBA32F view buffer takes 1 GiB.
 MAX_VIEW_SIDE = 8192
+# Light-view pixels are sized so that this fraction of the surface area (the part with the
+# densest UVs) may get fewer than `view_samples` pixels per texel; the footprint-aware splat
+# keeps those texels hole-free, only their visibility is sampled more coarsely.
+DENSITY_PERCENTILE = 0.10
+# Texels smaller than a light-view pixel by this factor (per side) leave holes between the
+# tent splats of neighbouring pixels; when more than DENSE_AREA_LIMIT of the texels are like
+# that, the bake uses the footprint-splitting shader variant (slower, so only then).
+FOOTPRINT_SPLIT = 1.5
+DENSE_AREA_LIMIT = 0.005
 
 
 class BakeInputError(ValueError):
@@ -41,6 +50,7 @@ class BakePlan:
     max_view_side: int
     target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
     drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
+    needs_footprint_splat: bool = False
     stats: dict = field(default_factory=dict)
 
     @property
@@ -122,11 +132,17 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     texel_world_area = (areas[useful] / scale**2) / (uv_area[useful] * size * size)
     order = np.argsort(texel_world_area)
     cum = np.cumsum(areas[useful][order])
-    # The 25th area-percentile face density: three quarters of the surface gets at least
+    # The 10th area-percentile face density: 90 % of the surface gets at least
     # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
-    density = texel_world_area[order][np.searchsorted(cum, 0.25 * cum[-1])]
+    density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
     pixel_size = float(np.sqrt(density / settings.view_samples))
     pixel_size = max(pixel_size, 2.0 / (MAX_VIEW_SIDE - 4))  # the target sphere has diameter 2
+
+    # Fraction of the texels (UV area, not surface area: a small dense region can hold many
+    # texels) that are FOOTPRINT_SPLIT times smaller than a pixel per side.
+    texel_side = np.sqrt(texel_world_area)
+    uv_used = uv_area[useful]
+    dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
     drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
     drawn_sphere = bounding_sphere(drawn)
@@ -135,8 +151,10 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
                  occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
-                 occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale)
+                 occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
+                 dense_uv_area_fraction=dense_fraction)
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32),
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
-                    pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere, stats)
+                    pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere,
+                    dense_fraction > DENSE_AREA_LIMIT, stats)

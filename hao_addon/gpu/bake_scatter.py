@@ -31,6 +31,9 @@ DEPTH_TOLERANCE = 2.0**-21
 # Depth layers kept per light-view pixel for max-distance bakes. A ray through a closed mesh
 # crosses an even number of surfaces; 16 holds eight nested shells. Overflow is counted.
 LAYERS = 16
+# Largest split of one pixel's UV footprint per axis (8 x 8 sub-splats); beyond that the UV
+# layout is over 8 texels per light-view pixel and the bake warns to raise view samples.
+MAX_FOOTPRINT = 8
 
 
 def _base_info(name: str) -> "gpu.types.GPUShaderCreateInfo":
@@ -66,12 +69,13 @@ def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
-def _splat_info(uniform: bool, layered: bool, wendland: bool) -> "gpu.types.GPUShaderCreateInfo":
+def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShaderCreateInfo":
     info = _base_info("splat")
     info.image(0, 'R32UI', 'UINT_2D', "accum_num", qualifiers={'READ', 'WRITE'})
     info.image(1, 'R32UI', 'UINT_2D', "accum_den", qualifiers={'READ', 'WRITE'})
     info.push_constant('FLOAT', "fixed_scale")
     info.push_constant('FLOAT', "depth_tolerance")
+    info.define("MAX_FOOTPRINT", str(MAX_FOOTPRINT if footprint else 1))
     if layered:
         info.image(2, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
         info.image(3, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
@@ -97,8 +101,9 @@ def layers_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_layers", LAYERS), _layers_info)
 
 
-def splat_shader(uniform: bool, layered: bool, wendland: bool) -> "gpu.types.GPUShader":
-    return cached_shader(("bake_splat", uniform, layered, wendland), lambda: _splat_info(uniform, layered, wendland))
+def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShader":
+    key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT)
+    return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint))
 
 
 def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
@@ -156,13 +161,15 @@ class ScatterBaker(util.GPUPass):
             self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
             self.prepass_prog = depth_shader()
             self.layer_count = self.layer_depth = self.overflow = None
-        self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered, settings.falloff == "wendland")
+        self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
+                                       settings.falloff == "wendland", plan.needs_footprint_splat)
         chunk = min(CHUNK_DIRECTIONS, settings.directions)
         self.fixed_scale = float(2.0**26 * settings.directions / (4.0 * chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
         self.den = np.zeros((size, size), dtype=np.float64)
         self.pending = 0
-        self.stats = dict(view_pixels=0, directions_done=0, layered=self.layered, layer_overflow_pixels=0)
+        self.stats = dict(view_pixels=0, directions_done=0, layered=self.layered, layer_overflow_pixels=0,
+                          footprint_splat=plan.needs_footprint_splat)
 
     def _release(self) -> None:
         self.all_batch = self.target_batch = None

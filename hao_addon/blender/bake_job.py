@@ -1,0 +1,195 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""A bake of one or more Blender objects, driven step by step (for progress and cancel).
+
+Nothing the user can see changes until ``commit``: files are written atomically first, then
+image datablocks and material nodes. The only change made earlier is a new ``AO_UV`` map
+for meshes without UVs (the evaluated mesh must carry it); ``cancel`` removes it again.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Generator
+
+import bpy
+import numpy as np
+
+from ..bake import BakeResult, bake_steps
+from ..core.imageio import format_for_path, write_ao_file
+from ..core.plan import BakeInputError
+from ..core.settings import BakeSettings
+from ..core.unwrap import xatlas_unwrap
+from . import images, mesh_data
+
+OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
+
+
+@dataclass
+class BakeRequest:
+    """targets: mesh objects to bake. occluders: 'TARGET' (self only), 'SELECTED' (the other
+    selected meshes too) or 'VISIBLE' (every visible mesh). uv_map: a UV map name, '' for the
+    active render UV map, or 'AUTO': AO_UV if present, else the first UV map, else a new
+    AO_UV unwrapped with xatlas.
+    image: an existing image to overwrite (one target only), else '<object>_AO' is created.
+    filepath: '' or a .png/.exr path; with several targets '{object}' in it is replaced."""
+
+    targets: list
+    settings: BakeSettings
+    occluders: str = "TARGET"
+    uv_map: str = "AUTO"
+    image: "bpy.types.Image | None" = None
+    image_name: str = ""
+    filepath: str = ""
+    wire_material: bool = False
+    extra_occluders: list = field(default_factory=list)
+
+
+def output_path_for(request: BakeRequest, obj) -> str:
+    if not request.filepath:
+        return ""
+    path = bpy.path.abspath(request.filepath)
+    if len(request.targets) > 1:
+        if "{object}" not in path:
+            stem, ext = os.path.splitext(path)
+            path = f"{stem}_{{object}}{ext}"
+        path = path.replace("{object}", bpy.path.clean_name(obj.name))
+    return path
+
+
+def validate_request(request: BakeRequest) -> None:
+    """Raise BakeInputError for anything that can be refused before touching the scene."""
+    request.settings.validated()
+    if not request.targets:
+        raise BakeInputError("no mesh selected: select one or more mesh objects to bake")
+    for obj in request.targets:
+        if obj.type != 'MESH':
+            raise BakeInputError(f"'{obj.name}' is not a mesh")
+        if len(obj.data.polygons) == 0:
+            raise BakeInputError(f"'{obj.name}' has no faces to bake")
+        name = request.uv_map
+        if name not in ("", "AUTO") and name not in obj.data.uv_layers:
+            raise BakeInputError(f"'{obj.name}' has no UV map named '{name}'")
+        if name == "" and not obj.data.uv_layers:
+            raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto (xatlas) to unwrap it")
+    if request.occluders not in OCCLUDER_MODES:
+        raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
+    if request.image is not None and len(request.targets) > 1:
+        raise BakeInputError("an existing image can receive only one object's bake")
+    for obj in request.targets:
+        path = output_path_for(request, obj)
+        if path:
+            try:
+                format_for_path(path)
+            except ValueError as exc:
+                raise BakeInputError(str(exc)) from None
+            folder = Path(path).parent
+            if not folder.is_dir():
+                raise BakeInputError(f"cannot write '{path}': folder does not exist")
+            if not os.access(folder, os.W_OK) or (Path(path).exists() and not os.access(path, os.W_OK)):
+                raise BakeInputError(f"cannot write '{path}': permission denied")
+
+
+class BakeJob:
+    """Prepare, run (``steps``), then ``commit`` or ``cancel``."""
+
+    def __init__(self, request: BakeRequest, depsgraph_getter) -> None:
+        validate_request(request)
+        self.request = request
+        self._depsgraph_getter = depsgraph_getter
+        self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
+        self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
+        self.committed: list[bpy.types.Image] = []
+        self.finished = False
+
+    # -- preparation -----------------------------------------------------------------------
+    def _uv_name_for(self, obj) -> str:
+        mesh = obj.data
+        name = self.request.uv_map
+        if name == "":
+            active = next((l for l in mesh.uv_layers if l.active_render), None) or mesh.uv_layers.active
+            return active.name
+        if name != "AUTO":
+            return name
+        if mesh_data.AO_UV_NAME in mesh.uv_layers:
+            return mesh_data.AO_UV_NAME  # ours from an earlier bake: reuse, never re-unwrap
+        if mesh.uv_layers:
+            return mesh.uv_layers[0].name  # AUTO: the first UV map when there is one
+        positions, tris, tri_loops = mesh_data.base_mesh_triangles(obj)
+        uvs = xatlas_unwrap(positions, tris, self.request.settings.size)
+        new_name = mesh_data.add_uv_layer(mesh, mesh_data.AO_UV_NAME, tri_loops, uvs)
+        self.created_uv.append((mesh, new_name))
+        return new_name
+
+    def _occluder_objects(self, target) -> list:
+        mode = self.request.occluders
+        if mode == "TARGET":
+            candidates = []
+        elif mode == "SELECTED":
+            candidates = [o for o in self.request.targets if o != target]
+            candidates += [o for o in bpy.context.selected_objects if o.type == 'MESH' and o not in candidates]
+        else:
+            candidates = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()]
+        candidates += list(self.request.extra_occluders)
+        seen, out = set(), []
+        for o in candidates:
+            if o != target and o.name not in seen:
+                seen.add(o.name)
+                out.append(o)
+        return out
+
+    # -- running ---------------------------------------------------------------------------
+    def steps(self) -> Generator[tuple[float, str], None, None]:
+        """Yield (fraction done, status text) after each light direction."""
+        req = self.request
+        uv_names = {obj.name: self._uv_name_for(obj) for obj in req.targets}
+        depsgraph = self._depsgraph_getter()
+        n = len(req.targets)
+        for k, obj in enumerate(req.targets):
+            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name])
+            occluders = [mesh_data.evaluated_soup(o, depsgraph, None) for o in self._occluder_objects(obj)]
+            gen = bake_steps(target, occluders, req.settings)
+            while True:
+                try:
+                    frac = next(gen)
+                except StopIteration as stop:
+                    result = stop.value
+                    break
+                yield (k + frac) / n, f"Baking AO of '{obj.name}' ({k + 1}/{n}): {frac * 100:.0f}%"
+            self.results.append((obj, uv_names[obj.name], result))
+        self.finished = True
+
+    def run(self) -> None:
+        for _ in self.steps():
+            pass
+
+    # -- ending ----------------------------------------------------------------------------
+    def commit(self) -> list:
+        """Write files (atomically), then images and material nodes. Returns the images."""
+        if not self.finished:
+            raise RuntimeError("commit() before the bake finished")
+        req = self.request
+        for obj, _uv, result in self.results:
+            path = output_path_for(req, obj)
+            if path:
+                write_ao_file(path, result.ao)
+        for obj, uv_name, result in self.results:
+            name = req.image_name or f"{obj.name}_AO"
+            image = images.store_ao_image(result.ao, name, req.image)
+            if req.wire_material:
+                images.wire_into_material(obj, image, uv_name)
+            self.committed.append(image)
+        return self.committed
+
+    def cancel(self) -> None:
+        """Undo the only early change: UV maps this job created."""
+        for mesh, name in reversed(self.created_uv):
+            layer = mesh.uv_layers.get(name)
+            if layer is not None:
+                mesh.uv_layers.remove(layer)
+        self.created_uv.clear()
+        self.results.clear()
+
+
+def results_arrays(job: BakeJob) -> dict[str, np.ndarray]:
+    return {obj.name: result.ao for obj, _uv, result in job.results}

@@ -1,0 +1,80 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""AO maps as Blender image datablocks, and wiring them into materials."""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+AO_NODE_LABEL = "HAO AO"
+AO_MIX_LABEL = "HAO AO Multiply"
+
+
+def store_ao_image(ao: np.ndarray, name: str, existing: bpy.types.Image | None = None) -> bpy.types.Image:
+    """Put (H, W) accessibility (row 0 = bottom) into a float image datablock, grey RGB with
+    alpha 1, colour space Non-Color (AO is data, not colour)."""
+    h, w = ao.shape
+    image = existing
+    if image is None:
+        image = bpy.data.images.new(name, w, h, alpha=False, float_buffer=True)
+    elif tuple(image.size) != (w, h):
+        image.scale(w, h)
+    image.colorspace_settings.name = 'Non-Color'
+    rgba = np.empty((h, w, 4), dtype=np.float32)
+    rgba[..., :3] = ao[..., None]
+    rgba[..., 3] = 1.0
+    image.pixels.foreach_set(rgba.ravel())
+    image.update()
+    return image
+
+
+def image_pixels_gray(image: bpy.types.Image) -> np.ndarray:
+    """(H, W) float32 red channel of an image datablock (row 0 = bottom)."""
+    w, h = image.size
+    px = np.empty(w * h * 4, dtype=np.float32)
+    image.pixels.foreach_get(px)
+    return px.reshape(h, w, 4)[..., 0]
+
+
+def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str) -> bpy.types.Material:
+    """Add an Image Texture node with the AO map (through a UV Map node) to the object's
+    active material, make it the active node, and multiply it into the Principled BSDF's
+    Base Color once. A material is created when the object has none."""
+    mat = obj.active_material
+    if mat is None:
+        mat = bpy.data.materials.new(f"{obj.name}_HAO")
+        obj.data.materials.append(mat)
+    mat.use_nodes = True
+    tree = mat.node_tree
+    tex = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeTexImage' and n.label == AO_NODE_LABEL), None)
+    if tex is None:
+        tex = tree.nodes.new('ShaderNodeTexImage')
+        tex.label = AO_NODE_LABEL
+        tex.location = (-700, 300)
+        uv_node = tree.nodes.new('ShaderNodeUVMap')
+        uv_node.location = (-900, 300)
+        uv_node.uv_map = uv_name
+        tree.links.new(uv_node.outputs["UV"], tex.inputs["Vector"])
+    else:
+        for link in tex.inputs["Vector"].links:
+            if link.from_node.bl_idname == 'ShaderNodeUVMap':
+                link.from_node.uv_map = uv_name
+    tex.image = image
+    tree.nodes.active = tex
+    bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
+    has_mix = any(n.label == AO_MIX_LABEL for n in tree.nodes)
+    if bsdf is not None and not has_mix:
+        base = bsdf.inputs["Base Color"]
+        mix = tree.nodes.new('ShaderNodeMix')
+        mix.label = AO_MIX_LABEL
+        mix.data_type = 'RGBA'
+        mix.blend_type = 'MULTIPLY'
+        mix.location = (bsdf.location.x - 250, bsdf.location.y)
+        mix.inputs[0].default_value = 1.0
+        a_in, b_in = mix.inputs[6], mix.inputs[7]  # the colour A and B sockets
+        if base.links:
+            tree.links.new(base.links[0].from_socket, a_in)
+        else:
+            a_in.default_value = base.default_value
+        tree.links.new(tex.outputs["Color"], b_in)
+        tree.links.new(mix.outputs[2], base)
+    return mat

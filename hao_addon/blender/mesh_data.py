@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Triangle soups from depsgraph-evaluated Blender objects (modifiers and armatures applied)."""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from ..core.geometry import TriangleSoup
+
+AO_UV_NAME = "AO_UV"
+
+
+def world_matrix(obj: bpy.types.Object) -> np.ndarray:
+    return np.array(obj.matrix_world, dtype=np.float64)
+
+
+def _mesh_arrays(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertex positions (V, 3), triangle vertex indices (F, 3), triangle loop indices (F, 3))."""
+    mesh.calc_loop_triangles()
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
+    mesh.vertices.foreach_get("co", co)
+    tri_verts = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int64)
+    mesh.loop_triangles.foreach_get("vertices", tri_verts)
+    tri_loops = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int64)
+    mesh.loop_triangles.foreach_get("loops", tri_loops)
+    return co.reshape(-1, 3), tri_verts.reshape(-1, 3), tri_loops.reshape(-1, 3)
+
+
+def loop_uvs(mesh: bpy.types.Mesh, name: str) -> np.ndarray:
+    """(L, 2) float64 UVs of every loop of the named UV map."""
+    layer = mesh.uv_layers.get(name)
+    if layer is None:
+        raise KeyError(f"mesh '{mesh.name}' has no UV map named '{name}'")
+    uv = np.empty(len(mesh.loops) * 2, dtype=np.float64)
+    layer.uv.foreach_get("vector", uv)
+    return uv.reshape(-1, 2)
+
+
+def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None) -> TriangleSoup:
+    """The object's evaluated mesh in world space, with the named UV map (or none)."""
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        co, tri_verts, tri_loops = _mesh_arrays(mesh)
+        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        world = co @ m[:3, :3].T + m[:3, 3]
+        uvs = loop_uvs(mesh, uv_name)[tri_loops] if uv_name else None
+        return TriangleSoup(world[tri_verts], uvs, name=obj.name,
+                            meta={"loop_count": len(mesh.loops), "vertex_count": len(mesh.vertices)})
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def base_mesh_triangles(obj: bpy.types.Object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Original (unevaluated) mesh: (positions (V, 3), triangles (F, 3), triangle loops (F, 3))."""
+    return _mesh_arrays(obj.data)
+
+
+def add_uv_layer(mesh: bpy.types.Mesh, name: str, tri_loops: np.ndarray, corner_uvs: np.ndarray) -> str:
+    """Create a new UV map from per-triangle-corner UVs (F, 3, 2); returns its actual name.
+
+    Loops shared by two triangles of one n-gon receive the UV of the later triangle; xatlas
+    keeps the triangles of a planar polygon in one chart, where the two agree.
+    The new map does not become the active one, so existing UV workflows are untouched.
+    """
+    active = mesh.uv_layers.active_index if len(mesh.uv_layers) else -1
+    layer = mesh.uv_layers.new(name=name, do_init=False)
+    if layer is None:
+        raise RuntimeError(f"mesh '{mesh.name}' cannot take another UV map (Blender allows 8)")
+    uv = np.zeros((len(mesh.loops), 2), dtype=np.float32)
+    uv[tri_loops.ravel()] = corner_uvs.reshape(-1, 2)
+    layer.uv.foreach_set("vector", uv.ravel())
+    if active >= 0:
+        mesh.uv_layers.active_index = active
+    return layer.name
+
+
+def is_bakeable_mesh(obj: bpy.types.Object) -> bool:
+    return obj is not None and obj.type == 'MESH'

@@ -1,0 +1,94 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Exact, atomic AO map files: 16-bit grayscale PNG and 32-bit float EXR (pure numpy + zlib).
+
+Blender's own savers apply view transforms and choose bit depths from scene settings; AO is
+data, so these writers store the numbers as they are. Files are written to a temporary name
+beside the target and renamed into place, so a failed or cancelled write never leaves a
+half-written image. Arrays are (H, W) with row 0 at the *bottom* (Blender's pixel order);
+files get the standard top-row-first orientation.
+"""
+from __future__ import annotations
+
+import os
+import struct
+import tempfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+FORMATS = {".png": "PNG", ".exr": "OPEN_EXR"}
+
+
+def format_for_path(path: str | Path) -> str:
+    ext = Path(path).suffix.lower()
+    if ext not in FORMATS:
+        raise ValueError(f"unsupported output extension '{ext}': use .png (16-bit) or .exr (32-bit float)")
+    return FORMATS[ext]
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise OSError(f"output folder does not exist: {path.parent}")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def png16_bytes(image: np.ndarray) -> bytes:
+    """16-bit grayscale PNG of image (H, W) in [0, 1], row 0 = bottom."""
+    img = np.clip(np.nan_to_num(np.asarray(image, np.float64)), 0.0, 1.0)
+    h, w = img.shape
+    q = np.round(img[::-1] * 65535.0).astype(">u2")  # flip to top-first, big-endian samples
+    raw = np.concatenate([np.zeros((h, 1), np.uint8), q.view(np.uint8).reshape(h, 2 * w)], axis=1)
+
+    def chunk(tag: bytes, payload: bytes) -> bytes:
+        return struct.pack(">I", len(payload)) + tag + payload + struct.pack(">I", zlib.crc32(tag + payload))
+
+    ihdr = struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)  # depth 16, colour type 0 (gray)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)) + chunk(b"IEND", b"")
+
+
+def exr32_bytes(image: np.ndarray) -> bytes:
+    """Single-channel ('Y') 32-bit float scanline OpenEXR, uncompressed, row 0 = bottom."""
+    img = np.ascontiguousarray(np.asarray(image, np.float32)[::-1])
+    h, w = img.shape
+
+    def attr(name: str, kind: str, payload: bytes) -> bytes:
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(payload)) + payload
+
+    channels = b"Y\0" + struct.pack("<iBxxxii", 2, 0, 1, 1) + b"\0"  # FLOAT, linear 0, sampling 1 1
+    header = (struct.pack("<ii", 20000630, 2)
+              + attr("channels", "chlist", channels)
+              + attr("compression", "compression", b"\0")
+              + attr("dataWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+              + attr("displayWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1))
+              + attr("lineOrder", "lineOrder", b"\0")
+              + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
+              + b"\0")
+    line_bytes = 4 * w
+    block = 8 + line_bytes
+    start = len(header) + 8 * h
+    offsets = struct.pack(f"<{h}Q", *(start + i * block for i in range(h)))
+    rows = np.empty((h, block), np.uint8)
+    rows[:, 0:4] = np.arange(h, dtype="<i4").view(np.uint8).reshape(h, 4)
+    rows[:, 4:8] = np.frombuffer(struct.pack("<i", line_bytes), np.uint8)
+    rows[:, 8:] = img.astype("<f4").view(np.uint8).reshape(h, line_bytes)
+    return header + offsets + rows.tobytes()
+
+
+def write_ao_file(path: str | Path, image: np.ndarray) -> None:
+    """Write (H, W) accessibility to .png (16-bit) or .exr (32-bit float), atomically."""
+    fmt = format_for_path(path)
+    if not np.isfinite(image).all():
+        raise ValueError("refusing to write an AO map containing NaN or Inf")
+    _atomic_write(Path(path), png16_bytes(image) if fmt == "PNG" else exr32_bytes(image))
