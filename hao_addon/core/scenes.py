@@ -91,3 +91,24 @@ def wall_accessibility(distance_to_wall: np.ndarray, max_distance: float, fallof
     chord = 2.0 * np.sqrt(1.0 - y * y)
     rho = occlusion_weight(x[:, None] / y[None, :], max_distance, falloff)
     return 1.0 - (rho * chord).sum(axis=1) / quadrature / np.pi
+
+
+def finite_wall_accessibility(distance_to_wall: np.ndarray, lateral: np.ndarray, width: float, height: float,
+                              grid: int = 2000) -> np.ndarray:
+    """Floor points next to a finite wall (unlimited distance), by midpoint quadrature of
+    the Malley disk (error about 1/grid). The wall stands at distance x in front of the point,
+    spans |y - lateral| <= width / 2 sideways and 0 <= z <= height."""
+    x = np.atleast_1d(np.asarray(distance_to_wall, float))
+    y0 = np.broadcast_to(np.asarray(lateral, float), x.shape)
+    c = (np.arange(grid) + 0.5) / grid
+    a, b = np.meshgrid(2.0 * c - 1.0, c, indexing="xy")  # a: sideways, b: towards the wall (> 0)
+    inside = a * a + b * b < 1.0
+    a, b = a[inside], b[inside]
+    up = np.sqrt(1.0 - a * a - b * b)
+    cell = (2.0 / grid) * (1.0 / grid)
+    out = np.empty_like(x)
+    for i, (xi, yi) in enumerate(zip(x, y0)):
+        t = xi / b
+        hit = (np.abs(yi + a * t) <= width / 2) & (up * t <= height)
+        out[i] = 1.0 - hit.sum() * cell / np.pi
+    return out

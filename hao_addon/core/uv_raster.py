@@ -41,14 +41,15 @@ def texel_surface_samples(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.nd
         first = face[yy, xx] < 0
         face[yy[first], xx[first]] = f
         bary[yy[first], xx[first]] = np.stack([w0[inside], w1[inside], w2[inside]], axis=1)[first]
-        hits[yy, xx] += 1
+        strict = (w0 > 1e-7) & (w1 > 1e-7) & (w2 > 1e-7)
+        hits[ys[strict], xs[strict]] += 1
     return face, bary, hits
 
 
 def interior_mask(face: np.ndarray, hits: np.ndarray, rings: int = 2) -> np.ndarray:
-    """Texels whose whole (2 rings + 1)^2 neighbourhood is covered exactly once: away from
+    """Texels whose whole (2 rings + 1)^2 neighbourhood is covered, never twice: away from
     chart borders and overlaps, where a texel-area bake and a point reference agree."""
-    ok = (face >= 0) & (hits == 1)
+    ok = (face >= 0) & (hits <= 1)
     out = ok.copy()
     h, w = ok.shape
     for dy in range(-rings, rings + 1):

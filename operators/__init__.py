@@ -1,0 +1,18 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Blender glue: properties, operators, panels and the command-line hook.
+
+Registration never touches the GPU (background mode has none until a bake asks for it).
+"""
+from . import bake_operator, cli_command, panels, properties
+
+_modules = (properties, bake_operator, panels, cli_command)
+
+
+def register() -> None:
+    for mod in _modules:
+        mod.register()
+
+
+def unregister() -> None:
+    for mod in reversed(_modules):
+        mod.unregister()

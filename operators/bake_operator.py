@@ -1,0 +1,165 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The Bake AO operator: blocking ``execute`` for scripts and background mode, a modal
+``invoke`` with progress bar, status text and ESC to cancel for artists."""
+from __future__ import annotations
+
+import time
+
+import bpy
+
+from ..hao_addon.blender.bake_job import BakeJob
+from ..hao_addon.core.plan import BakeInputError
+from ..hao_addon.gpu.context import GPUUnavailableError
+from ..hao_addon.gpu.shaders import ShaderCompileError
+
+# Errors a user can act on: reported, never raised into Blender's console.
+USER_ERRORS = (BakeInputError, GPUUnavailableError, ShaderCompileError, ValueError, OSError, KeyError, RuntimeError)
+# Wall time of GPU work per modal tick: short enough to keep the UI responsive.
+TICK_BUDGET_S = 0.1
+
+
+def bake_targets(context) -> list:
+    return [o for o in context.selected_objects if o.type == 'MESH']
+
+
+class ModalBakeRunner:
+    """The modal path's state machine, separate from the operator so tests can drive it
+    without a window: ``tick`` runs directions for up to one budget, ``cancel`` rolls back."""
+
+    def __init__(self, job: BakeJob, window_manager=None, workspace=None) -> None:
+        self.job = job
+        self.steps = job.steps()
+        self.wm = window_manager
+        self.workspace = workspace
+        self.fraction = 0.0
+        self.status = ""
+        if self.wm is not None:
+            self.wm.progress_begin(0, 1000)
+
+    def tick(self, budget_s: float = TICK_BUDGET_S) -> bool:
+        """Advance; True when the bake finished and was committed."""
+        end = time.perf_counter() + budget_s
+        while time.perf_counter() < end:
+            try:
+                self.fraction, self.status = next(self.steps)
+            except StopIteration:
+                self.job.commit()
+                self._end()
+                return True
+        if self.wm is not None:
+            self.wm.progress_update(int(self.fraction * 1000))
+        if self.workspace is not None:
+            self.workspace.status_text_set(f"{self.status}   (Esc to cancel)")
+        return False
+
+    def cancel(self) -> None:
+        self.steps.close()  # runs the bake generator's finally: GPU resources freed
+        self.job.cancel()
+        self._end()
+
+    def _end(self) -> None:
+        if self.wm is not None:
+            self.wm.progress_end()
+        if self.workspace is not None:
+            self.workspace.status_text_set(None)
+
+
+class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
+    """Bake ambient occlusion of the selected meshes into image textures on the GPU"""
+
+    bl_idname = "object.hao_bake_ao"
+    bl_label = "Bake AO"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    _runner: ModalBakeRunner | None = None
+    _timer = None
+
+    @classmethod
+    def poll(cls, context):
+        if context.mode != 'OBJECT':
+            cls.poll_message_set("Switch to Object Mode to bake")
+            return False
+        if not bake_targets(context):
+            cls.poll_message_set("Select one or more mesh objects to bake")
+            return False
+        if getattr(context.scene, "hao_bake", None) is None:
+            cls.poll_message_set("HAO settings are not registered")
+            return False
+        return True
+
+    def _make_job(self, context) -> BakeJob:
+        request = context.scene.hao_bake.to_request(bake_targets(context))
+        return BakeJob(request, context.evaluated_depsgraph_get)
+
+    def _report_images(self, images) -> None:
+        names = ", ".join(f"'{im.name}'" for im in images)
+        self.report({'INFO'}, f"Baked AO into {names}")
+
+    def execute(self, context):
+        try:
+            job = self._make_job(context)
+        except USER_ERRORS as exc:
+            self.report({'ERROR'}, str(exc))
+            return {'CANCELLED'}
+        try:
+            job.run()
+            images = job.commit()
+        except USER_ERRORS as exc:
+            job.cancel()
+            self.report({'ERROR'}, f"Bake AO failed: {exc}")
+            return {'CANCELLED'}
+        except BaseException:
+            job.cancel()
+            raise
+        self._report_images(images)
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        try:
+            job = self._make_job(context)
+        except USER_ERRORS as exc:
+            self.report({'ERROR'}, str(exc))
+            return {'CANCELLED'}
+        wm = context.window_manager
+        self._runner = ModalBakeRunner(job, wm, context.workspace)
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context, event):
+        if event.type == 'ESC':
+            self._stop(context, cancelled=True)
+            self.report({'WARNING'}, "Bake AO cancelled: nothing was changed")
+            return {'CANCELLED'}
+        if event.type != 'TIMER':
+            return {'RUNNING_MODAL'}  # keep the scene still while baking
+        try:
+            done = self._runner.tick()
+        except USER_ERRORS as exc:
+            self._stop(context, cancelled=True)
+            self.report({'ERROR'}, f"Bake AO failed: {exc}")
+            return {'CANCELLED'}
+        if done:
+            images = self._runner.job.committed
+            self._stop(context, cancelled=False)
+            self._report_images(images)
+            return {'FINISHED'}
+        return {'RUNNING_MODAL'}
+
+    def cancel(self, context):  # Blender calls this when the window closes mid-bake
+        self._stop(context, cancelled=True)
+
+    def _stop(self, context, cancelled: bool) -> None:
+        if self._timer is not None:
+            context.window_manager.event_timer_remove(self._timer)
+            self._timer = None
+        if self._runner is not None:
+            if cancelled:
+                self._runner.cancel()
+            self._runner = None
+
+
+classes = (OBJECT_OT_hao_bake_ao,)
+register, unregister = bpy.utils.register_classes_factory(classes)

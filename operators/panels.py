@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The AO tab of the 3D View sidebar."""
+from __future__ import annotations
+
+import bpy
+
+
+class VIEW3D_PT_hao_bake(bpy.types.Panel):
+    """Bake per-texel ambient occlusion on the GPU"""
+
+    bl_label = "Bake AO"
+    bl_idname = "VIEW3D_PT_hao_bake"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "AO"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.hao_bake
+        col = layout.column()
+        col.prop(settings, "size")
+        col.prop(settings, "directions")
+        col.prop(settings, "method")
+        col.separator()
+        col.prop(settings, "max_distance")
+        sub = col.column()
+        sub.active = settings.max_distance > 0.0
+        sub.prop(settings, "falloff")
+        col.prop(settings, "weighting")
+        col.prop(settings, "ignore_back_faces")
+        col.prop(settings, "occluders")
+        col.separator()
+        col.prop(settings, "uv_mode")
+        if settings.uv_mode == 'NAMED':
+            obj = context.active_object
+            if obj is not None and obj.type == 'MESH':
+                col.prop_search(settings, "uv_map", obj.data, "uv_layers", text="Name")
+            else:
+                col.prop(settings, "uv_map", text="Name")
+        col.prop(settings, "margin")
+        col.template_ID(settings, "image", new="image.new", open="image.open")
+        col.prop(settings, "filepath")
+        col.prop(settings, "wire_material")
+        col.prop(settings, "view_samples")
+        layout.separator()
+        layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
+
+
+classes = (VIEW3D_PT_hao_bake,)
+register, unregister = bpy.utils.register_classes_factory(classes)

@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""GPU bakes of scenes with known AO (both bake variants), and the reference tracer."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bake_helpers import assert_within_sample_tolerance, error_stats, sigma, texel_points
+from hao_addon.bake import bake
+from hao_addon.core import scenes
+from hao_addon.core.geometry import TriangleSoup
+from hao_addon.core.reference import reference_accessibility
+from hao_addon.core.settings import BakeSettings
+
+R = 1.0
+
+
+def sphere_on_plane():
+    return scenes.grid_plane(8.0, 16), scenes.uv_sphere(R, (0.0, 0.0, R))
+
+
+def floor_and_wall(width=2000.0, height=1000.0):
+    floor = scenes.grid_plane(2.0, 8)
+    floor.positions[:, :, 0] -= 1.05  # x in [-2.05, -0.05]: distances 0.05 .. 2.05 from the wall
+    return floor, scenes.wall(width, height, 0.0)
+
+
+@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("weighting", ["cosine", "uniform"])
+def test_lone_plane_is_exactly_open(gpu_context, method, weighting):
+    plane = scenes.grid_plane(4.0, 8)
+    res = bake(plane, [], BakeSettings(size=128, directions=64, method=method, weighting=weighting, margin=0),
+               use_cache=False)
+    assert res.covered.sum() > 0.95 * 128 * 128
+    # The ratio estimator makes an unoccluded texel exact up to fixed-point rounding (2^-26).
+    np.testing.assert_allclose(res.ao[res.covered], 1.0, atol=1e-5)
+
+
+@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("directions", [64, 256])
+def test_sphere_on_plane_matches_one_minus_r_over_d_cubed(gpu_context, method, directions):
+    plane, sphere = sphere_on_plane()
+    size = 256
+    res = bake(plane, [sphere], BakeSettings(size=size, directions=directions, method=method, margin=0),
+               use_cache=False)
+    pts, mask = texel_points(plane, size)
+    ref = scenes.sphere_on_plane_accessibility(np.linalg.norm(pts - [0, 0, R], axis=-1), R)
+    stats = error_stats(res.ao, ref, mask & res.covered)
+    assert stats["n"] > 0.9 * size * size
+    assert_within_sample_tolerance(stats, directions, f"{method} D={directions}")
+
+
+@pytest.mark.parametrize("method", ["scatter", "gather"])
+def test_floor_next_to_wall_unlimited(gpu_context, method):
+    floor, wall = floor_and_wall()
+    size, directions = 128, 256
+    res = bake(floor, [wall], BakeSettings(size=size, directions=directions, method=method, margin=0), use_cache=False)
+    pts, mask = texel_points(floor, size)
+    cols = slice(0, size)
+    # The wall is finite (2000 x 1000): its exact value differs from 1/2 by up to 1e-3.
+    xs = -pts[size // 2, cols, 0]
+    ref_line = scenes.finite_wall_accessibility(xs, 0.0, 2000.0, 1000.0)
+    assert np.all(np.abs(ref_line - 0.5) < 2e-3)
+    ref = np.broadcast_to(ref_line[None, :], (size, size))
+    assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, method)
+
+
+@pytest.mark.parametrize("falloff", ["none", "wendland"])
+@pytest.mark.parametrize("max_distance", [0.5, 1.0])
+def test_floor_next_to_wall_with_max_distance(gpu_context, falloff, max_distance):
+    floor, wall = floor_and_wall(width=20.0, height=10.0)  # infinite within reach of every texel
+    size, directions = 128, 256
+    res = bake(floor, [wall], BakeSettings(size=size, directions=directions, max_distance=max_distance,
+                                           falloff=falloff, margin=0), use_cache=False)
+    assert res.stats["layered"] and res.stats["layer_overflow_pixels"] == 0
+    pts, mask = texel_points(floor, size)
+    ref = scenes.wall_accessibility(-pts[..., 0].ravel(), max_distance, falloff).reshape(size, size)
+    assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, falloff)
+
+
+def test_ignore_back_faces(gpu_context):
+    floor, wall = floor_and_wall(width=20.0, height=10.0)
+    flipped = TriangleSoup(wall.positions[:, ::-1], wall.uvs[:, ::-1], name="flipped wall")  # faces away
+    kw = dict(size=64, directions=128, margin=0)
+    seen = bake(floor, [flipped], BakeSettings(**kw), use_cache=False)
+    ignored = bake(floor, [flipped], BakeSettings(ignore_back_faces=True, **kw), use_cache=False)
+    # The floor sees the wall's back: it occludes unless back faces are ignored.
+    assert seen.ao[seen.covered].mean() < 0.6
+    np.testing.assert_allclose(ignored.ao[ignored.covered], 1.0, atol=1e-5)
+    # A front-facing wall occludes either way.
+    front = bake(floor, [wall], BakeSettings(ignore_back_faces=True, **kw), use_cache=False)
+    assert abs(front.ao[front.covered].mean() - seen.ao[seen.covered].mean()) < 0.02
+
+
+def test_stretch_correction_nonuniform_uvs(gpu_context):
+    """UVs stretched non-uniformly (u -> u^2): the |J| weighting keeps the map a surface
+    average, so the analytic answer still holds at the texels' surface points."""
+    plane, sphere = sphere_on_plane()
+    warped = plane.uvs.copy()
+    warped[..., 0] = 0.05 + 0.9 * warped[..., 0] ** 2
+    plane = TriangleSoup(plane.positions, warped, name="warped plane")
+    size, directions = 256, 256
+    res = bake(plane, [sphere], BakeSettings(size=size, directions=directions, margin=0), use_cache=False)
+    pts, mask = texel_points(plane, size)
+    ref = scenes.sphere_on_plane_accessibility(np.linalg.norm(pts - [0, 0, R], axis=-1), R)
+    assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, "warped")
+
+
+def test_reference_tracer_on_sphere_on_plane():
+    plane, sphere = sphere_on_plane()
+    scene = np.concatenate([plane.positions, sphere.positions])
+    rho = np.linspace(0.3, 3.5, 12)
+    pts = np.stack([rho, np.zeros_like(rho), np.zeros_like(rho)], 1)
+    rays = 1024
+    got = reference_accessibility(pts, np.tile([0, 0, 1.0], (len(pts), 1)), scene, rays=rays)
+    exact = scenes.sphere_on_plane_accessibility(np.linalg.norm(pts - [0, 0, R], axis=1), R)
+    # The sphere is a 64x32 polygon (inscribed): its form factor is smaller by up to ~1 %.
+    tol = 4 * np.sqrt(exact * (1 - exact) / rays) + 0.01 * (1 - exact) + 1e-3
+    assert np.all(np.abs(got - exact) <= tol), (got - exact, tol)
+
+
+def test_reference_tracer_max_distance_and_backfaces():
+    floor, wall = floor_and_wall(width=20.0, height=10.0)
+    scene = np.concatenate([floor.positions, wall.positions])
+    xs = np.array([0.1, 0.3, 0.6, 0.9])
+    pts = np.stack([-xs, np.zeros(4), np.zeros(4)], 1)
+    normals = np.tile([0, 0, 1.0], (4, 1))
+    for falloff in ("none", "wendland"):
+        got = reference_accessibility(pts, normals, scene, rays=1024, max_distance=1.0, falloff=falloff)
+        exact = scenes.wall_accessibility(xs, 1.0, falloff)
+        assert np.all(np.abs(got - exact) < 4 * np.sqrt(0.25 / 1024)), (falloff, got - exact)
+    flipped = np.concatenate([floor.positions, wall.positions[:, ::-1]])
+    got = reference_accessibility(pts, normals, flipped, rays=256, ignore_back_faces=True)
+    np.testing.assert_allclose(got, 1.0)
+
+
+def test_sigma_bound_catches_a_two_percent_normalization_error():
+    """The tolerance is not vacuous: a 2 % scale error on a map near 0.9 exceeds it."""
+    for d in (64, 256, 1024, 4096):
+        assert 0.02 * 0.9 > sigma(d) / 8

@@ -1,0 +1,180 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Pure math of the baker: direction sets, kernels, normalization, views, seams, file IO."""
+from __future__ import annotations
+
+import struct
+import zlib
+
+import numpy as np
+import pytest
+
+from hao_addon.core import directions, kernels, normalization, scenes, seams, views
+from hao_addon.core.geometry import face_normals_areas, uv_areas
+from hao_addon.core.imageio import exr32_bytes, png16_bytes
+from hao_addon.core.settings import BakeSettings
+
+
+def test_fibonacci_sphere_is_unit_balanced_and_deterministic():
+    d = directions.bake_directions(1024, seed=3)
+    assert d.shape == (1024, 3)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    # Equal-area cells: the centroid of the set is at the origin to O(1/D).
+    assert np.linalg.norm(d.mean(axis=0)) < 2.0 / 1024
+    np.testing.assert_array_equal(d, directions.bake_directions(1024, seed=3))
+    assert not np.allclose(d, directions.bake_directions(1024, seed=4))
+
+
+@pytest.mark.parametrize("count", [64, 256, 4096])
+def test_hemisphere_cosine_sum_approaches_quarter(count):
+    """sum_d max(w_d . n, 0) -> D/4 for any n (the integral of cos over the hemisphere is pi,
+    the sphere's area 4 pi); the Fibonacci set's error shrinks faster than MC's 1/sqrt(D)."""
+    d = directions.bake_directions(count, seed=0)
+    n = directions.bake_directions(200, seed=99)
+    s = normalization.face_normalizers(n, d, "cosine")
+    rel = np.abs(s / (count / 4.0) - 1.0)
+    assert rel.max() < 2.0 / np.sqrt(count)  # a random set would need ~ 1.7 / sqrt(D) at 3 sigma
+    u = normalization.face_normalizers(n, d, "uniform")
+    assert np.abs(u / (count / 2.0) - 1.0).max() < 3.0 / np.sqrt(count)
+
+
+def test_face_normalizer_matches_brute_force_and_zero_normal():
+    d = directions.bake_directions(100, seed=1)
+    n = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 0, 0]])
+    s = normalization.face_normalizers(n, d, "cosine", chunk=2)
+    brute = [sum(max(float(x @ nn), 0.0) for x in d) for nn in n]
+    np.testing.assert_allclose(s, brute, rtol=1e-12)
+    assert s[2] == 0.0
+
+
+def test_stratified_cosine_directions_have_cosine_pdf():
+    rng = np.random.default_rng(0)
+    d = directions.stratified_cosine_hemisphere(4096, rng)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    assert (d[:, 2] >= 0).all()
+    # E[cos theta] under the pdf cos/pi is 2/3; stratification makes it tight.
+    assert abs(d[:, 2].mean() - 2.0 / 3.0) < 2e-3
+
+
+def test_frames_are_orthonormal_even_at_minus_z():
+    n = np.array([[0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0], [0.6, 0.0, 0.8]])
+    f = directions.frame_from_normal(n)
+    for m in f:
+        np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(f[:, 2], n)
+
+
+def test_wendland_kernel_shape():
+    h = 2.0
+    t = np.linspace(0, 3, 301)
+    w = kernels.wendland(t, h)
+    assert w[0] == 1.0 and np.all(w[t >= h] == 0.0)
+    assert np.all(np.diff(w) <= 1e-15)  # monotone
+    # C2 at the support's end: w, w' and w'' vanish at t = h.
+    eps = 1e-4
+    for k in (0, 1, 2):
+        val = np.diff(kernels.wendland(np.array([h - 2 * eps, h - eps, h]), h), n=k)[-1] / eps**k
+        assert abs(val) < 1e-3
+    with pytest.raises(ValueError):
+        kernels.wendland(t, 0.0)
+
+
+def test_occlusion_weight_definitions():
+    t = np.array([0.5, 1.5, np.inf])
+    np.testing.assert_array_equal(kernels.occlusion_weight(t, 0.0, "wendland"), [1, 1, 0])
+    np.testing.assert_array_equal(kernels.occlusion_weight(t, 1.0, "none"), [1, 0, 0])
+    np.testing.assert_allclose(kernels.occlusion_weight(t, 1.0, "wendland"), [kernels.wendland(0.5, 1.0), 0, 0])
+
+
+def test_views_map_target_into_clip_box_with_counter_clockwise_front_faces():
+    rng = np.random.default_rng(2)
+    pts = rng.normal(size=(50, 3))
+    omega = np.array([0.3, -0.5, 0.81])
+    omega /= np.linalg.norm(omega)
+    v = views.fit_view(omega, pts, None, 0.05, np.array([0.3, 0.7]), 4096)
+    clip = np.c_[pts, np.ones(len(pts))] @ v.matrix.T.astype(np.float64)
+    assert np.all(np.abs(clip[:, :3]) <= 1.0 + 1e-6)
+    # Square pixels of the requested size.
+    sx, sy = (np.linalg.norm(v.matrix[k, :3].astype(np.float64)) for k in (0, 1))
+    assert abs(2.0 / sx / v.width - 0.05) < 1e-5 and abs(2.0 / sy / v.height - 0.05) < 1e-5
+    # A triangle facing the light is counter-clockwise in NDC, and nearer the light is smaller depth.
+    basis = views.light_basis(omega)
+    tri = np.array([[0, 0, 0], basis[0], basis[1]]) @ np.eye(3)
+    ndc = (np.c_[tri, np.ones(3)] @ v.matrix.T.astype(np.float64))[:, :2]
+    area = np.cross(ndc[1] - ndc[0], ndc[2] - ndc[0])
+    assert area > 0
+    near = (np.r_[omega, 1] @ v.matrix.T)[2]
+    far = (np.r_[-omega, 1] @ v.matrix.T)[2]
+    assert near < far
+
+
+def test_geometry_degenerate_triangles_have_zero_normal_not_nan():
+    tris = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [1, 1, 1], [2, 2, 2]], [[1, 1, 1]] * 3], float)
+    n, a = face_normals_areas(tris)
+    assert np.isfinite(n).all() and np.isfinite(a).all()
+    np.testing.assert_allclose(n[0], [0, 0, 1])
+    assert a[1] == 0 and a[2] == 0 and not n[1].any()
+    assert uv_areas(np.zeros((1, 3, 2)))[0] == 0.0
+
+
+def test_dilation_fills_rings_with_neighbour_means():
+    v = np.zeros((7, 7), np.float32)
+    m = np.zeros((7, 7), bool)
+    v[3, 3], m[3, 3] = 0.5, True
+    out, valid = seams.dilate(v, m, 2)
+    assert valid[1:6, 1:6].all() and not valid[0].any()
+    assert np.allclose(out[valid], 0.5)
+
+
+def test_finalize_map_erodes_rim_and_grows_margin():
+    num = np.zeros((16, 16))
+    cov = np.zeros((16, 16))
+    cov[4:12, 4:12] = 1.0
+    cov[4, 4:12] = 0.3  # a thin rim: eroded, then refilled from inside
+    num[:] = 0.8 * cov
+    num[4, 4:12] = 0.0  # garbage on the rim must not survive
+    ao, covered, filled = seams.finalize_map(num, cov, margin=2)
+    assert not covered[4, 5] and filled[4, 5] and abs(ao[4, 5] - 0.8) < 1e-6
+    assert filled[2, 6] and not filled[1, 6]
+    assert ao[0, 0] == 1.0  # background
+
+
+def test_png16_round_trip_and_orientation():
+    img = np.linspace(0, 1, 12, dtype=np.float32).reshape(3, 4)  # row 0 = bottom
+    data = png16_bytes(img)
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    w, h, depth, ctype = struct.unpack(">IIBB", data[16:26])
+    assert (w, h, depth, ctype) == (4, 3, 16, 0)
+    idat = data[data.index(b"IDAT") + 4:data.index(b"IEND") - 8]
+    raw = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(3, 9)[:, 1:]
+    rows = raw.copy().view(">u2").reshape(3, 4) / 65535.0
+    np.testing.assert_allclose(rows[::-1], img, atol=1 / 65535)  # file's first row = image top
+
+
+def test_exr_header_and_payload():
+    img = np.arange(6, dtype=np.float32).reshape(2, 3) / 7.0
+    data = exr32_bytes(img)
+    assert struct.unpack("<ii", data[:8]) == (20000630, 2)
+    tail = np.frombuffer(data[-(8 + 12):], np.uint8)
+    assert struct.unpack("<ii", tail[:8].tobytes()) == (1, 12)  # last line block: y = 1, 12 bytes
+    np.testing.assert_array_equal(np.frombuffer(tail[8:].tobytes(), "<f4"), img[0])  # bottom row last
+
+
+def test_settings_validation_messages():
+    with pytest.raises(ValueError, match="map size"):
+        BakeSettings(size=0).validated()
+    with pytest.raises(ValueError, match="directions"):
+        BakeSettings(directions=0).validated()
+    with pytest.raises(ValueError, match="gather"):
+        BakeSettings(method="gather", max_distance=1.0).validated()
+    with pytest.raises(ValueError, match="max distance"):
+        BakeSettings(max_distance=float("nan")).validated()
+
+
+def test_analytic_formulas():
+    assert scenes.sphere_on_plane_accessibility(1.0, 1.0) == 0.0
+    np.testing.assert_allclose(scenes.sphere_on_plane_accessibility(2.0, 1.0), 1 - 1 / 8)
+    np.testing.assert_allclose(scenes.wall_accessibility([0.0, 0.3], 0.0), 0.5)
+    np.testing.assert_allclose(scenes.wall_accessibility([0.0, 1.0, 2.0], 1.0), [0.5, 1.0, 1.0], atol=1e-12)
+    # Wendland quadrature against the step version's limit: w <= step, so A_wendland >= A_step.
+    x = np.array([0.1, 0.4, 0.8])
+    assert np.all(scenes.wall_accessibility(x, 1.0, "wendland") >= scenes.wall_accessibility(x, 1.0, "none"))
