@@ -47,6 +47,7 @@ def clear_blend_data() -> None:
             if getattr(item, "type", None) == 'RENDER_RESULT':
                 continue
             coll.remove(item)
+    bpy.context.view_layer.update()
 
 
 @pytest.fixture
@@ -55,6 +56,10 @@ def scene(addon, gpu_context):
     clear_blend_data()
     from hao_addon.bake import clear_cache
     clear_cache()
+    settings = bpy.context.scene.hao_bake
+    for prop in settings.bl_rna.properties:
+        if prop.identifier != "rna_type":
+            settings.property_unset(prop.identifier)  # back to the defaults
     yield bpy.context.scene
     clear_blend_data()
 
@@ -76,7 +81,7 @@ def soup_to_object(soup, name: str | None = None, uv: bool = True):
 
 
 def select_only(*objs) -> None:
-    for o in bpy.context.view_layer.objects:
+    for o in bpy.context.scene.objects:
         o.select_set(False)
     for o in objs:
         o.select_set(True)

@@ -175,7 +175,9 @@ class BakeJob:
                 write_ao_file(path, result.ao)
         for obj, uv_name, result in self.results:
             name = req.image_name or f"{obj.name}_AO"
-            image = images.store_ao_image(result.ao, name, req.image)
+            # Re-baking updates the object's AO image in place (materials keep pointing at it).
+            existing = req.image or bpy.data.images.get(name)
+            image = images.store_ao_image(result.ao, name, existing)
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
             self.committed.append(image)

@@ -16,8 +16,16 @@ def store_ao_image(ao: np.ndarray, name: str, existing: bpy.types.Image | None =
     image = existing
     if image is None:
         image = bpy.data.images.new(name, w, h, alpha=False, float_buffer=True)
-    elif tuple(image.size) != (w, h):
-        image.scale(w, h)
+    elif tuple(image.size) != (w, h) or not image.is_float:
+        if image.source == 'GENERATED':
+            # Generated images are resized through their generator settings (scale() leaves
+            # an unloaded generated buffer at its old size).
+            image.generated_width, image.generated_height = w, h
+            image.use_generated_float = True
+        else:
+            image.scale(w, h)
+    if len(image.pixels) != w * h * 4:
+        raise RuntimeError(f"image '{image.name}' could not be resized to {w}x{h}")
     image.colorspace_settings.name = 'Non-Color'
     rgba = np.empty((h, w, 4), dtype=np.float32)
     rgba[..., :3] = ao[..., None]
@@ -43,7 +51,8 @@ def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: s
     if mat is None:
         mat = bpy.data.materials.new(f"{obj.name}_HAO")
         obj.data.materials.append(mat)
-    mat.use_nodes = True
+    if mat.node_tree is None:  # materials made before 5.0 may lack a node tree
+        mat.use_nodes = True
     tree = mat.node_tree
     tex = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeTexImage' and n.label == AO_NODE_LABEL), None)
     if tex is None:

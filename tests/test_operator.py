@@ -1,0 +1,238 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The Bake AO operator on real Blender data: images, UV maps, materials, files, cancel, undo."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import bpy
+from conftest import select_only, soup_to_object
+from hao_addon.core import scenes
+from hao_addon.gpu.util import live_pass_count, snapshot_state
+
+
+def uv_array(mesh, name):
+    a = np.empty(len(mesh.loops) * 2, np.float32)
+    mesh.uv_layers[name].uv.foreach_get("vector", a)
+    return a
+
+
+def monkey():
+    bpy.ops.mesh.primitive_monkey_add()
+    obj = bpy.context.active_object
+    return obj
+
+
+def small_settings(scene, **kw):
+    s = scene.hao_bake
+    s.size, s.directions, s.margin = 128, 32, 4
+    for k, v in kw.items():
+        setattr(s, k, v)
+    return s
+
+
+def test_poll_explains_why_it_is_greyed_out(scene):
+    select_only()
+    assert not bpy.ops.object.hao_bake_ao.poll()
+    with pytest.raises(RuntimeError, match="Select one or more mesh objects"):
+        bpy.ops.object.hao_bake_ao()
+
+
+def test_bake_creates_float_non_color_image_and_keeps_uvs(scene):
+    obj = monkey()
+    before = uv_array(obj.data, "UVMap")
+    small_settings(scene)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    image = bpy.data.images[f"{obj.name}_AO"]
+    assert image.is_float and image.colorspace_settings.name == 'Non-Color'
+    assert tuple(image.size) == (128, 128)
+    px = np.empty(128 * 128 * 4, np.float32)
+    image.pixels.foreach_get(px)
+    gray = px.reshape(128, 128, 4)[..., 0]
+    assert np.isfinite(gray).all() and gray.min() >= 0 and gray.max() <= 1
+    assert gray.min() < 0.5 < gray.max()  # the monkey has deep creases and open surfaces
+    np.testing.assert_array_equal(uv_array(obj.data, "UVMap"), before)
+    assert [l.name for l in obj.data.uv_layers] == ["UVMap"]
+
+
+def test_mesh_without_uvs_gets_ao_uv_from_xatlas(scene):
+    obj = monkey()
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    small_settings(scene, uv_mode='AUTO')
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert [l.name for l in obj.data.uv_layers] == ["AO_UV"]
+    uv = uv_array(obj.data, "AO_UV").reshape(-1, 2)
+    assert uv.min() >= 0 and uv.max() <= 1 and np.ptp(uv, axis=0).min() > 0.5
+    # A second bake reuses AO_UV instead of unwrapping again.
+    bpy.ops.object.hao_bake_ao()
+    assert [l.name for l in obj.data.uv_layers] == ["AO_UV"]
+
+
+def test_named_uv_map_missing_is_a_clear_error(scene):
+    monkey()
+    small_settings(scene, uv_mode='NAMED', uv_map="Nope")
+    with pytest.raises(RuntimeError, match="no UV map named 'Nope'"):
+        bpy.ops.object.hao_bake_ao()
+
+
+def test_existing_image_is_overwritten_and_material_wired(scene):
+    obj = monkey()
+    target = bpy.data.images.new("Mine", 64, 64, float_buffer=True)
+    small_settings(scene, image=target, wire_material=True)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert tuple(target.size) == (128, 128) and f"{obj.name}_AO" not in bpy.data.images
+    mat = obj.active_material
+    tex = [n for n in mat.node_tree.nodes if n.bl_idname == 'ShaderNodeTexImage']
+    assert len(tex) == 1 and tex[0].image == target and mat.node_tree.nodes.active == tex[0]
+    uvnode = tex[0].inputs["Vector"].links[0].from_node
+    assert uvnode.uv_map == "UVMap"
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled')
+    assert bsdf.inputs["Base Color"].links[0].from_node.label == "HAO AO Multiply"
+    # Baking again does not stack more nodes.
+    n_nodes = len(mat.node_tree.nodes)
+    bpy.ops.object.hao_bake_ao()
+    assert len(mat.node_tree.nodes) == n_nodes
+
+
+@pytest.mark.parametrize("ext", ["png", "exr"])
+def test_saved_file_matches_image_and_orientation(scene, tmp_path, ext):
+    obj = monkey()
+    path = tmp_path / f"ao.{ext}"
+    small_settings(scene, filepath=str(path))
+    bpy.ops.object.hao_bake_ao()
+    baked = bpy.data.images[f"{obj.name}_AO"]
+    ref = np.empty(128 * 128 * 4, np.float32)
+    baked.pixels.foreach_get(ref)
+    loaded = bpy.data.images.load(str(path))
+    loaded.colorspace_settings.name = 'Non-Color'
+    got = np.empty(128 * 128 * 4, np.float32)
+    loaded.pixels.foreach_get(got)
+    # Blender reads both files bottom-up like its own pixels: same orientation, same values.
+    tol = 1.0 / 65535 + 1e-6 if ext == "png" else 1e-7
+    np.testing.assert_allclose(got.reshape(128, 128, 4)[..., 0], ref.reshape(128, 128, 4)[..., 0], atol=tol)
+    assert not list(tmp_path.glob("*.part"))
+
+
+def test_unwritable_output_fails_before_anything_changes(scene, tmp_path):
+    obj = monkey()
+    small_settings(scene, filepath=str(tmp_path / "missing" / "ao.png"))
+    with pytest.raises(RuntimeError, match="folder does not exist"):
+        bpy.ops.object.hao_bake_ao()
+    small_settings(scene, filepath=str(tmp_path / "ao.jpg"))
+    with pytest.raises(RuntimeError, match="unsupported output extension"):
+        bpy.ops.object.hao_bake_ao()
+    assert f"{obj.name}_AO" not in bpy.data.images
+
+
+def test_nan_vertices_and_empty_mesh_are_reported(scene):
+    obj = monkey()
+    obj.data.vertices[0].co = (float("nan"), 0.0, 0.0)
+    small_settings(scene)
+    with pytest.raises(RuntimeError, match="NaN"):
+        bpy.ops.object.hao_bake_ao()
+    empty = bpy.data.objects.new("Empty", bpy.data.meshes.new("Empty"))
+    scene.collection.objects.link(empty)
+    select_only(empty)
+    with pytest.raises(RuntimeError, match="no faces"):
+        bpy.ops.object.hao_bake_ao()
+    assert not [i for i in bpy.data.images if i.name.endswith("_AO")]
+
+
+def test_cancel_leaves_no_image_uv_map_or_material_change(scene, addon):
+    from hao_ext.operators.bake_operator import ModalBakeRunner
+    from hao_ext.operators.properties import HAO_PG_bake_settings  # noqa: F401  (registered)
+    from hao_addon.blender.bake_job import BakeJob
+
+    obj = monkey()
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    mat = bpy.data.materials.new("Keep")
+    if mat.node_tree is None:
+        mat.use_nodes = True
+    obj.data.materials.append(mat)
+    nodes_before = sorted(n.name for n in mat.node_tree.nodes)
+    images_before = set(bpy.data.images.keys())
+    settings = small_settings(scene, uv_mode='AUTO', wire_material=True, directions=64)
+    job = BakeJob(settings.to_request([obj]), bpy.context.evaluated_depsgraph_get)
+
+    class FakeWM:
+        calls = []
+
+        def progress_begin(self, a, b): self.calls.append("begin")
+        def progress_update(self, v): self.calls.append(v)
+        def progress_end(self): self.calls.append("end")
+
+    class FakeWorkspace:
+        texts = []
+
+        def status_text_set(self, t): self.texts.append(t)
+
+    wm, ws = FakeWM(), FakeWorkspace()
+    runner = ModalBakeRunner(job, wm, ws)
+    assert runner.tick(budget_s=0.05) is False  # part-way through
+    assert 0 < runner.fraction < 1 and "Esc to cancel" in ws.texts[-1]
+    assert "AO_UV" in obj.data.uv_layers  # the only early change...
+    runner.cancel()
+    assert "AO_UV" not in obj.data.uv_layers  # ...is rolled back
+    assert set(bpy.data.images.keys()) == images_before
+    assert sorted(n.name for n in mat.node_tree.nodes) == nodes_before
+    assert wm.calls[-1] == "end" and ws.texts[-1] is None
+    assert live_pass_count() == 0
+
+
+def test_modal_runner_completes_and_commits(scene):
+    from hao_ext.operators.bake_operator import ModalBakeRunner
+    from hao_addon.blender.bake_job import BakeJob
+
+    obj = monkey()
+    job = BakeJob(small_settings(scene).to_request([obj]), bpy.context.evaluated_depsgraph_get)
+    runner = ModalBakeRunner(job)
+    while not runner.tick(budget_s=0.05):
+        pass
+    assert f"{obj.name}_AO" in bpy.data.images
+
+
+def test_undo_restores_the_scene(scene):
+    obj = monkey()
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    small_settings(scene, uv_mode='AUTO', wire_material=True)
+    bpy.ops.ed.undo_push(message="before bake")
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    bpy.ops.ed.undo_push(message="after bake")
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects["Suzanne"]
+    assert "AO_UV" not in obj.data.uv_layers
+    assert "Suzanne_AO" not in bpy.data.images
+    assert obj.active_material is None
+
+
+def test_twenty_bakes_leave_no_gpu_resources_or_state(scene):
+    from hao_addon.gpu.shaders import cached_shader_count
+    obj = monkey()
+    small_settings(scene, directions=8, size=64)
+    bpy.ops.object.hao_bake_ao()
+    state, shaders = snapshot_state(), cached_shader_count()
+    for i in range(20):
+        scene.hao_bake.seed = i + 1  # defeat the cache: every bake really runs
+        assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert live_pass_count() == 0
+    assert snapshot_state() == state
+    assert cached_shader_count() == shaders  # variants compile once, never per bake
+    assert len([i for i in bpy.data.images if i.name.startswith(obj.name)]) == 1
+
+
+def test_selected_occluders_darken_the_floor(scene):
+    from hao_addon.blender.images import image_pixels_gray
+    floor = soup_to_object(scenes.grid_plane(8.0, 16), "Floor")
+    ball = soup_to_object(scenes.uv_sphere(1.0, (0, 0, 1.0), 32, 16), "Ball")
+    small_settings(scene, occluders='TARGET')
+    select_only(floor)
+    bpy.ops.object.hao_bake_ao()
+    alone = image_pixels_gray(bpy.data.images["Floor_AO"])
+    bpy.data.images.remove(bpy.data.images["Floor_AO"])
+    np.testing.assert_allclose(alone, 1.0, atol=1e-5)
+    small_settings(scene, occluders='SELECTED')
+    select_only(floor, ball)
+    bpy.ops.object.hao_bake_ao()  # bakes both selected meshes, each occluding the other
+    shaded = image_pixels_gray(bpy.data.images["Floor_AO"])
+    assert shaded[64, 64] < 0.2 and shaded[2, 2] > 0.95  # contact point dark, corners open
+    assert "Ball_AO" in bpy.data.images
