@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Work skipped when the scene does not need it: far occluders, empty texels, re-bakes."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hao_addon.bake import bake
+from hao_addon.core import scenes
+from hao_addon.core.geometry import TriangleSoup
+from hao_addon.core.settings import BakeSettings
+
+
+def test_occluders_beyond_max_distance_are_not_drawn(gpu_context):
+    plane = scenes.grid_plane(4.0, 8)
+    near = scenes.uv_sphere(0.5, (0.0, 0.0, 0.6), 24, 12)
+    far = scenes.uv_sphere(0.5, (0.0, 0.0, 9.0), 24, 12)  # 8.5 above the plane: out of reach
+    s = BakeSettings(size=64, directions=64, max_distance=2.0, margin=0)
+    with_far = bake(plane, [near, far], s, use_cache=False)
+    without = bake(plane, [near], s, use_cache=False)
+    assert with_far.stats["occluder_objects_culled"] == 1
+    assert with_far.stats["occluder_faces_drawn"] == near.face_count
+    np.testing.assert_array_equal(with_far.ao, without.ao)
+    # With unlimited distance the far sphere counts and is drawn.
+    unlimited = bake(plane, [near, far], BakeSettings(size=64, directions=64, margin=0), use_cache=False)
+    assert unlimited.stats["occluder_objects_culled"] == 0
+    assert unlimited.stats["occluder_faces_drawn"] == near.face_count + far.face_count
+
+
+def test_uncovered_texels_cost_nothing(gpu_context):
+    """The light-view work follows the covered texels, not the map size: the same mesh at
+    the same texel density in a 16x larger map (UVs in a quarter of each axis) rasterizes the
+    same number of light-view pixels per direction."""
+    plane, sphere = scenes.grid_plane(4.0, 8), scenes.uv_sphere(0.5, (0, 0, 0.5), 24, 12)
+    full = bake(plane, [sphere], BakeSettings(size=128, directions=16, margin=0), use_cache=False)
+    corner = TriangleSoup(plane.positions, plane.uvs * 0.25, name="corner")
+    small = bake(corner, [sphere], BakeSettings(size=512, directions=16, margin=0), use_cache=False)
+    assert abs(small.stats["covered_texels"] - full.stats["covered_texels"]) < 0.02 * full.stats["covered_texels"]
+    ratio = small.stats["view_pixels"] / full.stats["view_pixels"]
+    assert 0.97 < ratio < 1.03, ratio
+
+
+def test_rebake_with_unchanged_input_is_cached(gpu_context):
+    plane, sphere = scenes.grid_plane(4.0, 8), scenes.uv_sphere(0.5, (0, 0, 0.5), 24, 12)
+    s = BakeSettings(size=256, directions=128)
+    t0 = time.perf_counter()
+    first = bake(plane, [sphere], s)
+    t_first = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    second = bake(plane, [sphere], s)
+    t_second = time.perf_counter() - t0
+    assert not first.stats["cache_hit"] and second.stats["cache_hit"]
+    np.testing.assert_array_equal(first.ao, second.ao)
+    assert t_second < 0.05 * t_first, (t_first, t_second)
+    # Any change in geometry, UVs or settings misses the cache.
+    moved = TriangleSoup(sphere.positions + [0, 0, 1e-4], None)
+    assert not bake(plane, [moved], s).stats["cache_hit"]
+    assert not bake(plane, [sphere], BakeSettings(size=256, directions=129)).stats["cache_hit"]
