@@ -1,8 +1,12 @@
-/* Shared by the bake passes: fixed-point tent splats into R32UI accumulators.
+/* Shared by the bake passes: fixed-point tent splats into one R32UI accumulator.
  *
  * Float image atomics do not exist on every driver (llvmpipe has none) and would make sums
  * depend on execution order. Integer adds are associative, so bakes are bit-identical run to
- * run. The caller chooses `fixed_scale` so that a chunk of directions cannot overflow 2^32
+ * run. Numerator and denominator share one 32-bit word, denominator in the high 16 bits and
+ * numerator in the low 16: each numerator addend is at most its denominator addend, so the
+ * low field cannot carry into the high one while the denominator fits, and one atomic does
+ * the work of two (image atomics dominate this pass on llvmpipe). The caller chooses
+ * `fixed_scale` and flushes often enough that a chunk's denominator stays below 2^16
  * (see hao_addon/gpu/bake_scatter.py). */
 void splat_bilinear(vec2 texel_pos, float weight_num, float weight_den)
 {
@@ -13,7 +17,7 @@ void splat_bilinear(vec2 texel_pos, float weight_num, float weight_den)
   vec2 base = floor(q);
   vec2 f = q - base;
   ivec2 i0 = ivec2(base);
-  ivec2 size = imageSize(accum_den);
+  ivec2 size = imageSize(accum);
   vec4 wts = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
   for (int k = 0; k < 4; k++) {
     ivec2 c = i0 + ivec2(k & 1, k >> 1);
@@ -22,11 +26,8 @@ void splat_bilinear(vec2 texel_pos, float weight_num, float weight_den)
     }
     uint add_den = uint(weight_den * wts[k] * fixed_scale + 0.5);
     if (add_den != 0u) {
-      imageAtomicAdd(accum_den, c, add_den);
-      uint add_num = uint(weight_num * wts[k] * fixed_scale + 0.5);
-      if (add_num != 0u) {
-        imageAtomicAdd(accum_num, c, add_num);
-      }
+      uint add_num = min(uint(weight_num * wts[k] * fixed_scale + 0.5), add_den);
+      imageAtomicAdd(accum, c, (add_den << 16) | add_num);
     }
   }
 }

@@ -99,9 +99,11 @@ class GatherBaker(util.GPUPass):
                 gpu.state.depth_test_set('LESS')
                 gpu.state.depth_mask_set(True)
                 gpu.state.face_culling_set(culling)
+                gpu.state.color_mask_set(False, False, False, False)  # depth only
                 self.depth_prog.bind()
                 self.depth_prog.uniform_float("view_proj", view.matrix.T.ravel())
                 self.all_batch.draw(self.depth_prog)
+                gpu.state.color_mask_set(True, True, True, True)
             with self.accum_fb.bind():
                 gpu.state.viewport_set(0, 0, size, size)
                 gpu.state.depth_test_set('NONE')

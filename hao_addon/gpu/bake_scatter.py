@@ -9,11 +9,15 @@ a denominator accumulator, and into a numerator accumulator when it is the visib
 value for an unoccluded texel is exactly 1 and whose denominator doubles as the texel's UV
 coverage (about 1 inside a chart, less on its rim, 2 where two islands overlap).
 
-Fixed point: a direction adds about (4 / D) * coverage to a texel's denominator, so a chunk of
-C directions adds about 4 C / D. The scale makes a chunk's expected sum 2^26, leaving a factor
-64 below 2^32 for overlapping islands and the tent's ripple. After each chunk both
-accumulators are read into float64 and cleared, so D can grow without overflow, and each
-contribution keeps at least 2^26 * 4 / D * |J| * cos * tent units of precision.
+Fixed point: numerator and denominator are packed in one R32UI word (16 bits each, see
+gpu_shaders/bake_common.glsl). A direction adds about (4 / D) * coverage to a texel's
+denominator, so a chunk of C directions adds about 4 C / D; the scale makes that 2^12, which
+leaves a factor 16 below 2^16 for overlapping UV islands and the tent's ripple. After each
+chunk of CHUNK_DIRECTIONS the word is read back, unpacked into float64 sums and cleared, so D
+can grow without overflow. A direction then adds 2^12 / C = 256 units per texel, spread over
+a few fragments: rounding to integers costs well under 1 % per addend and averages out. If a
+chunk ever fills more than half the field (heavily stacked UV islands), later chunks are
+halved, and the stat `max_chunk_fill` reports the peak.
 """
 from __future__ import annotations
 
@@ -24,7 +28,8 @@ from ..core.plan import BakePlan
 from . import util
 from .shaders import cached_shader, glsl_source
 
-CHUNK_DIRECTIONS = 64
+CHUNK_DIRECTIONS = 16
+CHUNK_TARGET = 2.0**12  # expected denominator per texel per chunk, in fixed-point units
 # Depth agreement between the two passes (NDC depth in [0, 1]; the depth range spans a few
 # normalized units, so this is ~1e-6 of the scene's radius).
 DEPTH_TOLERANCE = 2.0**-21
@@ -71,14 +76,13 @@ def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
 
 def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShaderCreateInfo":
     info = _base_info("splat")
-    info.image(0, 'R32UI', 'UINT_2D', "accum_num", qualifiers={'READ', 'WRITE'})
-    info.image(1, 'R32UI', 'UINT_2D', "accum_den", qualifiers={'READ', 'WRITE'})
+    info.image(0, 'R32UI', 'UINT_2D', "accum", qualifiers={'READ', 'WRITE'})
     info.push_constant('FLOAT', "fixed_scale")
     info.push_constant('FLOAT', "depth_tolerance")
     info.define("MAX_FOOTPRINT", str(MAX_FOOTPRINT if footprint else 1))
     if layered:
-        info.image(2, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
-        info.image(3, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+        info.image(1, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
+        info.image(2, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
         info.push_constant('FLOAT', "depth_span")
         info.push_constant('FLOAT', "max_distance")
         info.define("MAX_DISTANCE", "1")
@@ -118,12 +122,12 @@ def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
 
 
 def estimate_bytes(plan: BakePlan) -> int:
-    """GPU memory this pass allocates: two accumulators, the view depth and a dummy colour,
+    """GPU memory this pass allocates: the accumulator, the view depth and a dummy colour,
     and for max-distance bakes the per-pixel layer lists."""
     side = plan.max_view_side
     layered = plan.settings.max_distance > 0.0
     per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
-    return plan.settings.size**2 * 8 + side * side * per_pixel
+    return plan.settings.size**2 * 4 + side * side * per_pixel
 
 
 class ScatterBaker(util.GPUPass):
@@ -142,10 +146,8 @@ class ScatterBaker(util.GPUPass):
         self.layered = settings.max_distance > 0.0
         self.all_batch = plan_batch(plan, with_occluders=True)
         self.target_batch = plan_batch(plan, with_occluders=False)
-        self.accum_num = gpu.types.GPUTexture((size, size), format='R32UI')
-        self.accum_den = gpu.types.GPUTexture((size, size), format='R32UI')
-        for tex in (self.accum_num, self.accum_den):
-            tex.clear(format='UINT', value=(0,))
+        self.accum = gpu.types.GPUTexture((size, size), format='R32UI')
+        self.accum.clear(format='UINT', value=(0,))
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
         self.splat_fb = gpu.types.GPUFrameBuffer(color_slots=self.dummy)
         if self.layered:
@@ -163,17 +165,17 @@ class ScatterBaker(util.GPUPass):
             self.layer_count = self.layer_depth = self.overflow = None
         self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
                                        settings.falloff == "wendland", plan.needs_footprint_splat)
-        chunk = min(CHUNK_DIRECTIONS, settings.directions)
-        self.fixed_scale = float(2.0**26 * settings.directions / (4.0 * chunk))
+        self.chunk = min(CHUNK_DIRECTIONS, settings.directions)
+        self.fixed_scale = float(CHUNK_TARGET * settings.directions / (4.0 * self.chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
         self.den = np.zeros((size, size), dtype=np.float64)
         self.pending = 0
         self.stats = dict(view_pixels=0, directions_done=0, layered=self.layered, layer_overflow_pixels=0,
-                          footprint_splat=plan.needs_footprint_splat)
+                          footprint_splat=plan.needs_footprint_splat, max_chunk_fill=0.0)
 
     def _release(self) -> None:
         self.all_batch = self.target_batch = None
-        self.accum_num = self.accum_den = self.depth = self.dummy = None
+        self.accum = self.depth = self.dummy = None
         self.layer_count = self.layer_depth = self.overflow = None
         self.depth_fb = self.splat_fb = None
 
@@ -191,8 +193,7 @@ class ScatterBaker(util.GPUPass):
         w, h = view.width, view.height
         # Ignoring back faces: a ray from a texel towards the light meets the back of a face
         # exactly when that face looks towards the light, i.e. faces the light camera. So the
-        # pre-pass culls FRONT faces; the splat pass draws only light-facing target faces and
-        # culls nothing.
+        # pre-pass culls FRONT faces; the splat pass draws only light-facing target faces.
         culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
         with util.scoped_state():
             gpu.state.blend_set('NONE')
@@ -221,17 +222,22 @@ class ScatterBaker(util.GPUPass):
                     gpu.state.depth_test_set('LESS')
                     gpu.state.depth_mask_set(True)
                     gpu.state.face_culling_set(culling)
+                    # Depth only. (Never mask colour in passes with image atomics: llvmpipe
+                    # then skips their fragment shaders, side effects and all.)
+                    gpu.state.color_mask_set(False, False, False, False)
                     self._set_view(self.prepass_prog, view, prepass=True)
                     self.all_batch.draw(self.prepass_prog)
+                    gpu.state.color_mask_set(True, True, True, True)
             with self.splat_fb.bind():
                 gpu.state.viewport_set(0, 0, w, h)
                 gpu.state.depth_test_set('NONE')
                 gpu.state.depth_mask_set(False)
-                gpu.state.face_culling_set('NONE')
+                # Target faces turned away from the light add nothing (cos <= 0): cull them
+                # instead of rasterizing and discarding. Front = counter-clockwise = facing it.
+                gpu.state.face_culling_set('BACK')
                 shader = self.splat_prog
                 self._set_view(shader, view)
-                shader.image("accum_num", self.accum_num)
-                shader.image("accum_den", self.accum_den)
+                shader.image("accum", self.accum)
                 shader.uniform_float("fixed_scale", self.fixed_scale)
                 shader.uniform_float("depth_tolerance", DEPTH_TOLERANCE)
                 if self.layered:
@@ -245,7 +251,7 @@ class ScatterBaker(util.GPUPass):
         self.stats["view_pixels"] += w * h
         self.stats["directions_done"] += 1
         self.pending += 1
-        if self.pending >= CHUNK_DIRECTIONS:
+        if self.pending >= self.chunk:
             self.flush()
 
     def flush(self) -> None:
@@ -254,9 +260,15 @@ class ScatterBaker(util.GPUPass):
             # Fragment image atomics are not ordered with later reads by the framebuffer
             # rules; an empty dispatch issues the image/texture-fetch barrier first.
             util.image_barrier()
-            for tex, total in ((self.accum_num, self.num), (self.accum_den, self.den)):
-                total += util.texture_to_numpy(tex, np.uint32).astype(np.float64) / self.fixed_scale
-                tex.clear(format='UINT', value=(0,))
+            packed = util.texture_to_numpy(self.accum, np.uint32)
+            self.accum.clear(format='UINT', value=(0,))
+            den = packed >> 16
+            fill = float(den.max()) / 65535.0
+            self.stats["max_chunk_fill"] = max(self.stats["max_chunk_fill"], fill)
+            if fill > 0.5 and self.chunk > 1:
+                self.chunk //= 2  # stacked UV islands: keep later chunks far from overflow
+            self.den += den.astype(np.float64) / self.fixed_scale
+            self.num += (packed & 0xFFFF).astype(np.float64) / self.fixed_scale
             if self.layered:
                 self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
             self.pending = 0

@@ -130,7 +130,7 @@ def sync(tex: "gpu.types.GPUTexture") -> None:
 def scoped_state() -> Iterator[None]:
     """Restore the drawing state a pass may change: blend, depth test, depth write,
     viewport; face culling and the scissor test have no getters and return to Blender's
-    defaults (off), which is what Blender's own draw code expects between passes."""
+    defaults (off; colour writes on), which Blender's own draw code expects between passes."""
     blend = gpu.state.blend_get()
     depth_test = gpu.state.depth_test_get()
     depth_mask = gpu.state.depth_mask_get()
@@ -142,6 +142,7 @@ def scoped_state() -> Iterator[None]:
         gpu.state.depth_test_set(depth_test)
         gpu.state.depth_mask_set(depth_mask)
         gpu.state.face_culling_set('NONE')
+        gpu.state.color_mask_set(True, True, True, True)
         gpu.state.scissor_test_set(False)
         gpu.state.viewport_set(*viewport)
         gpu.shader.unbind()
