@@ -18,7 +18,9 @@ void main()
   float depth = light_pos.z * 0.5 + 0.5;
   float visible = 1.0;
   if (all(greaterThanEqual(px, ivec2(0))) && all(lessThan(px, view_size))) {
-    float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 10.0);
+    /* Clamped at tan = 100 (cos ~ 0.01): steeper directions carry almost no cosine weight, and
+     * a lower clamp let grazing directions shadow open planes (acne of ~1e-3). */
+    float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 100.0);
     float bias = (1.5 * tan_theta + 0.5) * pixel_depth;
     float stored = texelFetch(depth_tex, px, 0).r;
     visible = (depth - bias <= stored) ? 1.0 : 0.0;

@@ -40,7 +40,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--ignore-back-faces", action="store_true")
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
     b.add_argument("--margin", type=int, default=16, help="texels grown past each UV island (default 16)")
-    b.add_argument("--method", choices=("scatter", "gather"), default="scatter")
+    b.add_argument("--method", choices=("auto", "scatter", "gather"), default="auto",
+                   help="auto (default): gather for unlimited distance, scatter with --max-distance")
     b.add_argument("--view-samples", type=float, default=2.0, help="light-view pixels per texel (default 2)")
     b.add_argument("--object", default="", help="mesh to bake (default: the mesh with the most faces)")
     b.add_argument("--occluders", choices=("target", "visible"), default="visible",

@@ -33,8 +33,11 @@ def error_stats(ao: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> dict:
                 p99=float(np.percentile(np.abs(e), 99)), n=int(mask.sum()))
 
 
-def assert_within_sample_tolerance(stats: dict, directions: int, label: str = "") -> None:
+def assert_within_sample_tolerance(stats: dict, directions: int, label: str = "", max_floor: float = 0.0) -> None:
+    """max_floor: an error bound that does not shrink with D (the gather's shadow-map
+    resolution near contact points); the max-error check uses the larger of the two."""
     s = sigma(directions)
     assert stats["rmse"] <= s / 2, f"{label} RMSE {stats['rmse']:.4f} > {s / 2:.4f} ({stats})"
     assert abs(stats["bias"]) <= s / 8, f"{label} bias {stats['bias']:.4f} > {s / 8:.4f} ({stats})"
-    assert stats["max"] <= 2 * s, f"{label} max error {stats['max']:.4f} > {2 * s:.4f} ({stats})"
+    bound = max(2 * s, max_floor)
+    assert stats["max"] <= bound, f"{label} max error {stats['max']:.4f} > {bound:.4f} ({stats})"

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import DATA, ROOT
+from conftest import ROOT
 
 SAMPLE = ROOT / "samples" / "spot.obj"
 

@@ -140,7 +140,6 @@ def test_nan_vertices_and_empty_mesh_are_reported(scene):
 
 def test_cancel_leaves_no_image_uv_map_or_material_change(scene, addon):
     from hao_ext.operators.bake_operator import ModalBakeRunner
-    from hao_ext.operators.properties import HAO_PG_bake_settings  # noqa: F401  (registered)
     from hao_addon.blender.bake_job import BakeJob
 
     obj = monkey()

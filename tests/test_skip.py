@@ -33,9 +33,10 @@ def test_uncovered_texels_cost_nothing(gpu_context):
     the same texel density in a 16x larger map (UVs in a quarter of each axis) rasterizes the
     same number of light-view pixels per direction."""
     plane, sphere = scenes.grid_plane(4.0, 8), scenes.uv_sphere(0.5, (0, 0, 0.5), 24, 12)
-    full = bake(plane, [sphere], BakeSettings(size=128, directions=16, margin=0), use_cache=False)
+    full = bake(plane, [sphere], BakeSettings(size=128, directions=16, margin=0, method="scatter"), use_cache=False)
     corner = TriangleSoup(plane.positions, plane.uvs * 0.25, name="corner")
-    small = bake(corner, [sphere], BakeSettings(size=512, directions=16, margin=0), use_cache=False)
+    small = bake(corner, [sphere], BakeSettings(size=512, directions=16, margin=0, method="scatter"),
+                 use_cache=False)
     assert abs(small.stats["covered_texels"] - full.stats["covered_texels"]) < 0.02 * full.stats["covered_texels"]
     ratio = small.stats["view_pixels"] / full.stats["view_pixels"]
     assert 0.97 < ratio < 1.03, ratio

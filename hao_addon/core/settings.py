@@ -7,7 +7,7 @@ from dataclasses import asdict, dataclass
 from .kernels import FALLOFFS
 from .normalization import WEIGHTINGS
 
-METHODS = ("scatter", "gather")
+METHODS = ("auto", "scatter", "gather")
 MAX_DIRECTIONS = 65536
 
 
@@ -31,7 +31,7 @@ class BakeSettings:
     weighting: str = "cosine"
     ignore_back_faces: bool = False
     margin: int = 16
-    method: str = "scatter"
+    method: str = "auto"
     view_samples: float = 4.0
     seed: int = 0
 
@@ -57,6 +57,13 @@ class BakeSettings:
             raise ValueError("the gather (shadow-map) baseline supports only unlimited distance: "
                              "a depth map keeps the occluder nearest the light, not the one nearest the texel")
         return self
+
+    @property
+    def resolved_method(self) -> str:
+        """The bake variant that runs: 'auto' picks by the max distance."""
+        if self.method != "auto":
+            return self.method
+        return "scatter" if self.max_distance > 0.0 else "gather"
 
     def cache_key(self) -> tuple:
         return tuple(sorted(asdict(self).items()))

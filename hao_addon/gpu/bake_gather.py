@@ -15,29 +15,19 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
-from .bake_scatter import depth_shader, plan_batch
+from .light_view import depth_prepass, plan_batch, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 
 def _gather_info(uniform: bool) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo("hao_bake_gather_iface")
-    iface.smooth('VEC3', "light_pos")
-    iface.flat('VEC4', "face_data")
-    info = gpu.types.GPUShaderCreateInfo()
-    info.vertex_in(0, 'VEC3', "pos")
-    info.vertex_in(1, 'VEC2', "uv")
-    info.vertex_in(2, 'VEC4', "face")
-    info.vertex_out(iface)
-    info.push_constant('MAT4', "view_proj")
-    info.push_constant('VEC4', "omega")
-    info.push_constant('VEC2', "tex_size")
+    info = soup_shader_info("bake_gather", "bake_gather.vert",
+                            (('smooth', 'VEC3', "light_pos"), ('flat', 'VEC4', "face_data")),
+                            ('VEC4', "gather_out"))
     info.push_constant('IVEC2', "view_size")
     info.push_constant('FLOAT', "pixel_depth")
     info.sampler(0, 'FLOAT_2D', "depth_tex")
-    info.fragment_out(0, 'VEC4', "gather_out")
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
-    info.vertex_source(glsl_source("bake_gather.vert"))
     info.fragment_source(glsl_source("bake_gather.frag"))
     return info
 
@@ -73,7 +63,6 @@ class GatherBaker(util.GPUPass):
         self.accum_fb = gpu.types.GPUFrameBuffer(color_slots=self.accum)
         with self.accum_fb.bind():
             gpu.state.active_framebuffer_get().clear(color=(0.0, 0.0, 0.0, 0.0))
-        self.depth_prog = depth_shader()
         self.gather_prog = gather_shader(plan.settings.weighting == "uniform")
         self.stats = dict(view_pixels=0, directions_done=0, uv_fragments_per_direction=size * size)
 
@@ -89,21 +78,7 @@ class GatherBaker(util.GPUPass):
         culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
         with util.scoped_state():
             gpu.state.blend_set('NONE')
-            with self.depth_fb.bind():
-                fb = gpu.state.active_framebuffer_get()
-                gpu.state.viewport_set(0, 0, w, h)
-                gpu.state.scissor_set(0, 0, w, h)
-                gpu.state.scissor_test_set(True)
-                fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-                gpu.state.scissor_test_set(False)
-                gpu.state.depth_test_set('LESS')
-                gpu.state.depth_mask_set(True)
-                gpu.state.face_culling_set(culling)
-                gpu.state.color_mask_set(False, False, False, False)  # depth only
-                self.depth_prog.bind()
-                self.depth_prog.uniform_float("view_proj", view.matrix.T.ravel())
-                self.all_batch.draw(self.depth_prog)
-                gpu.state.color_mask_set(True, True, True, True)
+            depth_prepass(self.depth_fb, self.all_batch, view, culling)
             with self.accum_fb.bind():
                 gpu.state.viewport_set(0, 0, size, size)
                 gpu.state.depth_test_set('NONE')

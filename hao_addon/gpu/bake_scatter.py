@@ -26,6 +26,7 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
+from .light_view import RASTER_VARYINGS, depth_prepass, plan_batch, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 CHUNK_DIRECTIONS = 16
@@ -41,31 +42,8 @@ LAYERS = 16
 MAX_FOOTPRINT = 8
 
 
-def _base_info(name: str) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo(f"hao_bake_{name}_iface")
-    iface.smooth('VEC2', "uv_texel")
-    iface.flat('VEC4', "face_data")
-    info = gpu.types.GPUShaderCreateInfo()
-    info.vertex_in(0, 'VEC3', "pos")
-    info.vertex_in(1, 'VEC2', "uv")
-    info.vertex_in(2, 'VEC4', "face")
-    info.vertex_out(iface)
-    info.push_constant('MAT4', "view_proj")
-    info.push_constant('VEC4', "omega")
-    info.push_constant('VEC2', "tex_size")
-    info.fragment_out(0, 'FLOAT', "dummy_out")
-    info.vertex_source(glsl_source("bake_raster.vert"))
-    return info
-
-
-def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
-    info = _base_info("depth")
-    info.fragment_source(glsl_source("bake_depth.frag"))
-    return info
-
-
 def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
-    info = _base_info("layers")
+    info = soup_shader_info("bake_layers", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
     info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
     info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
     info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
@@ -75,7 +53,7 @@ def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
 
 
 def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShaderCreateInfo":
-    info = _base_info("splat")
+    info = soup_shader_info("bake_splat", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
     info.image(0, 'R32UI', 'UINT_2D', "accum", qualifiers={'READ', 'WRITE'})
     info.push_constant('FLOAT', "fixed_scale")
     info.push_constant('FLOAT', "depth_tolerance")
@@ -97,10 +75,6 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool) -
     return info
 
 
-def depth_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("bake_depth",), _depth_info)
-
-
 def layers_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_layers", LAYERS), _layers_info)
 
@@ -108,17 +82,6 @@ def layers_shader() -> "gpu.types.GPUShader":
 def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShader":
     key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT)
     return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint))
-
-
-def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
-    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)."""
-    ft, fo = len(plan.target_positions), len(plan.occluder_positions) if with_occluders else 0
-    pos = np.concatenate([plan.target_positions.reshape(-1, 3), plan.occluder_positions[:fo].reshape(-1, 3)])
-    uv = np.concatenate([plan.target_uvs.reshape(-1, 2), np.zeros((3 * fo, 2), np.float32)])
-    occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
-    face = np.concatenate([np.repeat(plan.target_faces, 3, axis=0), np.repeat(occ_face, 3, axis=0)])
-    assert len(pos) == 3 * (ft + fo)
-    return util.make_batch('TRIS', {"pos": ('F32', pos), "uv": ('F32', uv), "face": ('F32', face)})
 
 
 def estimate_bytes(plan: BakePlan) -> int:
@@ -161,7 +124,6 @@ class ScatterBaker(util.GPUPass):
         else:
             self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
             self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
-            self.prepass_prog = depth_shader()
             self.layer_count = self.layer_depth = self.overflow = None
         self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
                                        settings.falloff == "wendland", plan.needs_footprint_splat)
@@ -212,22 +174,7 @@ class ScatterBaker(util.GPUPass):
                     self.all_batch.draw(shader)
                 util.image_barrier()  # the splat pass reads the lists with imageLoad
             else:
-                with self.depth_fb.bind():
-                    fb = gpu.state.active_framebuffer_get()
-                    gpu.state.viewport_set(0, 0, w, h)
-                    gpu.state.scissor_set(0, 0, w, h)
-                    gpu.state.scissor_test_set(True)
-                    fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-                    gpu.state.scissor_test_set(False)
-                    gpu.state.depth_test_set('LESS')
-                    gpu.state.depth_mask_set(True)
-                    gpu.state.face_culling_set(culling)
-                    # Depth only. (Never mask colour in passes with image atomics: llvmpipe
-                    # then skips their fragment shaders, side effects and all.)
-                    gpu.state.color_mask_set(False, False, False, False)
-                    self._set_view(self.prepass_prog, view, prepass=True)
-                    self.all_batch.draw(self.prepass_prog)
-                    gpu.state.color_mask_set(True, True, True, True)
+                depth_prepass(self.depth_fb, self.all_batch, view, culling)
             with self.splat_fb.bind():
                 gpu.state.viewport_set(0, 0, w, h)
                 gpu.state.depth_test_set('NONE')

@@ -1,0 +1,64 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Markdown tables from bench/results/bake_bench.json (pasted into the README).
+
+    .venv/bin/python bench/report.py [bench/results/bake_bench.json]
+
+Equal-error speed-up: for each Cycles run, the time HAO needs for the same interior RMSE,
+interpolated linearly in log(time)-log(RMSE) between the two HAO runs around it.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def time_at_rmse(runs: list[dict], rmse: float) -> float | None:
+    t = np.log([r["seconds"] for r in runs])
+    e = np.log([r["rmse"] for r in runs])
+    order = np.argsort(e)
+    if not e.min() <= np.log(rmse) <= e.max():
+        return None
+    return float(np.exp(np.interp(np.log(rmse), e[order], t[order])))
+
+
+def main() -> int:
+    path = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parent / "results" / "bake_bench.json")
+    res = json.loads(path.read_text())
+    lines = []
+    for name, m in res["meshes"].items():
+        lines.append(f"**{name}** ({m['triangles']:,} triangles, {m['size']}x{m['size']}; xatlas "
+                     f"{m['xatlas_seconds']:.1f} s, not included below)\n")
+        lines.append("| method | directions / samples | time (s) | RMSE | p99 | bias |")
+        lines.append("|---|---:|---:|---:|---:|---:|")
+        for key, label in (("scatter", "HAO scatter"), ("gather", "HAO gather"), ("cycles", "Cycles CPU")):
+            for r in m["runs"][key]:
+                n = r.get("directions", r.get("samples"))
+                lines.append(f"| {label} | {n} | {r['seconds']:.2f} | {r['rmse']:.4f} | {r['p99']:.4f} | {r['bias']:+.4f} |")
+        lines.append("")
+        lines.append("| Cycles samples | Cycles RMSE | Cycles time (s) | HAO scatter, same RMSE | HAO gather, same RMSE |")
+        lines.append("|---:|---:|---:|---:|---:|")
+        for r in m["runs"]["cycles"]:
+            cells = []
+            for key in ("scatter", "gather"):
+                t = time_at_rmse(m["runs"][key], r["rmse"])
+                cells.append("outside measured range" if t is None else f"{t:.2f} s ({r['seconds'] / t:.1f}x faster)")
+            lines.append(f"| {r['samples']} | {r['rmse']:.4f} | {r['seconds']:.2f} | {cells[0]} | {cells[1]} |")
+        lines.append("")
+    sw = res.get("triangle_sweep")
+    if sw:
+        lines.append("Cost against triangle count (scatter, 1024x1024, 64 directions, UV spheres over a plane):\n")
+        lines.append("| triangles | ms per direction |")
+        lines.append("|---:|---:|")
+        for r in sw:
+            lines.append(f"| {r['triangles']:,} | {r['ms_per_direction']:.1f} |")
+        lines.append("")
+    lines.append(f"Machine: {res['machine']['platform']}; Blender {res['machine']['blender']}; {res['machine']['gpu']}.")
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

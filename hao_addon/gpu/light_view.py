@@ -1,0 +1,83 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Pieces shared by both bakers: the triangle-soup shader interface, the soup batch, and the
+light-view depth pre-pass."""
+from __future__ import annotations
+
+import gpu
+import numpy as np
+
+from ..core.plan import BakePlan
+from ..core.views import OrthoView
+from . import util
+from .shaders import cached_shader, glsl_source
+
+
+def soup_shader_info(name: str, vertex_file: str, varyings: tuple[tuple[str, str, str], ...],
+                     fragment_out: tuple[str, str]) -> "gpu.types.GPUShaderCreateInfo":
+    """Create-info for a shader drawing a plan batch (pos, uv, face per vertex) from a light
+    view: push constants view_proj, omega, tex_size; varyings as (mode, type, name) with mode
+    'smooth' or 'flat'; one fragment output (type, name)."""
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_{name}_iface")
+    for mode, typ, var in varyings:
+        getattr(iface, mode)(typ, var)
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC3', "pos")
+    info.vertex_in(1, 'VEC2', "uv")
+    info.vertex_in(2, 'VEC4', "face")
+    info.vertex_out(iface)
+    info.push_constant('MAT4', "view_proj")
+    info.push_constant('VEC4', "omega")
+    info.push_constant('VEC2', "tex_size")
+    info.fragment_out(0, *fragment_out)
+    info.vertex_source(glsl_source(vertex_file))
+    return info
+
+
+RASTER_VARYINGS = (('smooth', 'VEC2', "uv_texel"), ('flat', 'VEC4', "face_data"))
+
+
+def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = soup_shader_info("bake_depth", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
+    info.fragment_source(glsl_source("bake_depth.frag"))
+    return info
+
+
+def depth_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("bake_depth",), _depth_info)
+
+
+def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
+    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)."""
+    ft = len(plan.target_positions)
+    fo = len(plan.occluder_positions) if with_occluders else 0
+    pos = np.concatenate([plan.target_positions.reshape(-1, 3), plan.occluder_positions[:fo].reshape(-1, 3)])
+    uv = np.concatenate([plan.target_uvs.reshape(-1, 2), np.zeros((3 * fo, 2), np.float32)])
+    occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
+    face = np.concatenate([np.repeat(plan.target_faces, 3, axis=0), np.repeat(occ_face, 3, axis=0)])
+    assert len(pos) == 3 * (ft + fo)
+    return util.make_batch('TRIS', {"pos": ('F32', pos), "uv": ('F32', uv), "face": ('F32', face)})
+
+
+def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
+    """Clear the view's sub-rectangle and draw `batch` depth-only from the light.
+
+    Colour writes are masked: llvmpipe then runs its depth-only path. (Never mask colour in
+    passes with image atomics: llvmpipe then skips their fragment shaders, side effects and
+    all.) Call inside util.scoped_state()."""
+    w, h = view.width, view.height
+    shader = depth_shader()
+    with framebuffer.bind():
+        fb = gpu.state.active_framebuffer_get()
+        gpu.state.viewport_set(0, 0, w, h)
+        gpu.state.scissor_set(0, 0, w, h)
+        gpu.state.scissor_test_set(True)
+        fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+        gpu.state.scissor_test_set(False)
+        gpu.state.depth_test_set('LESS')
+        gpu.state.depth_mask_set(True)
+        gpu.state.face_culling_set(culling)
+        gpu.state.color_mask_set(False, False, False, False)
+        shader.bind()
+        shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
+        batch.draw(shader)
+        gpu.state.color_mask_set(True, True, True, True)
