@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
-from .light_view import depth_prepass, plan_batch, soup_shader_info
+from .light_view import LightViewBaker, depth_prepass, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 
@@ -36,26 +36,20 @@ def gather_shader(uniform: bool) -> "gpu.types.GPUShader":
     return cached_shader(("bake_gather", uniform), lambda: _gather_info(uniform))
 
 
-def estimate_bytes(plan: BakePlan) -> int:
-    side = plan.max_view_side
-    return plan.settings.size**2 * 16 + side * side * 8
+class GatherBaker(LightViewBaker):
+    """Owns the depth map and the UV-space accumulation target of one bake."""
 
-
-class GatherBaker(util.GPUPass):
-    """Owns the depth map, the UV-space accumulation target and the batches of one bake."""
-
-    @classmethod
-    def check_limits(cls, plan: BakePlan) -> None:
-        util.check_texture_limits(plan.settings.size, plan.max_view_side, estimate_bytes(plan))
+    @staticmethod
+    def bytes_needed(plan: BakePlan) -> int:
+        """RGBA32F accumulator, view depth and dummy colour."""
+        side = plan.max_view_side
+        return plan.settings.size**2 * 16 + side * side * 8
 
     def __init__(self, plan: BakePlan) -> None:
-        super().__init__()
         if plan.settings.max_distance > 0.0:
             raise ValueError("the gather baseline supports only unlimited distance")
-        self.plan = plan
+        super().__init__(plan)
         size, side = plan.settings.size, plan.max_view_side
-        self.all_batch = plan_batch(plan, with_occluders=True)
-        self.target_batch = plan_batch(plan, with_occluders=False)
         self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
         self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
@@ -80,11 +74,7 @@ class GatherBaker(util.GPUPass):
             gpu.state.blend_set('NONE')
             depth_prepass(self.depth_fb, self.all_batch, view, culling)
             with self.accum_fb.bind():
-                gpu.state.viewport_set(0, 0, size, size)
-                gpu.state.depth_test_set('NONE')
-                gpu.state.depth_mask_set(False)
-                gpu.state.face_culling_set('NONE')
-                gpu.state.blend_set('ADDITIVE_PREMULT')  # exact ONE, ONE sums
+                util.set_overlay_pass_state(size, size, blend='ADDITIVE_PREMULT')  # exact ONE, ONE sums
                 shader = self.gather_prog
                 shader.bind()
                 shader.uniform_float("view_proj", view.matrix.T.ravel())

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
-from .light_view import RASTER_VARYINGS, depth_prepass, plan_batch, soup_shader_info
+from .light_view import RASTER_VARYINGS, LightViewBaker, depth_prepass, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 CHUNK_DIRECTIONS = 16
@@ -84,31 +84,24 @@ def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool) 
     return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint))
 
 
-def estimate_bytes(plan: BakePlan) -> int:
-    """GPU memory this pass allocates: the accumulator, the view depth and a dummy colour,
-    and for max-distance bakes the per-pixel layer lists."""
-    side = plan.max_view_side
-    layered = plan.settings.max_distance > 0.0
-    per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
-    return plan.settings.size**2 * 4 + side * side * per_pixel
+class ScatterBaker(LightViewBaker):
+    """Owns the accumulator and the light-view targets of one bake."""
 
-
-class ScatterBaker(util.GPUPass):
-    """Owns the accumulators, the light-view targets and the batches of one bake."""
-
-    @classmethod
-    def check_limits(cls, plan: BakePlan) -> None:
-        util.check_texture_limits(plan.settings.size, plan.max_view_side, estimate_bytes(plan))
+    @staticmethod
+    def bytes_needed(plan: BakePlan) -> int:
+        """The packed accumulator, the view depth and a dummy colour, and for max-distance
+        bakes the per-pixel layer lists."""
+        side = plan.max_view_side
+        layered = plan.settings.max_distance > 0.0
+        per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
+        return plan.settings.size**2 * 4 + side * side * per_pixel
 
     def __init__(self, plan: BakePlan) -> None:
-        super().__init__()
-        self.plan = plan
+        super().__init__(plan)
         settings = plan.settings
         size = settings.size
         side = plan.max_view_side
         self.layered = settings.max_distance > 0.0
-        self.all_batch = plan_batch(plan, with_occluders=True)
-        self.target_batch = plan_batch(plan, with_occluders=False)
         self.accum = gpu.types.GPUTexture((size, size), format='R32UI')
         self.accum.clear(format='UINT', value=(0,))
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
@@ -162,10 +155,7 @@ class ScatterBaker(util.GPUPass):
             if self.layered:
                 self.layer_count.clear(format='UINT', value=(0,))
                 with self.splat_fb.bind():
-                    gpu.state.viewport_set(0, 0, w, h)
-                    gpu.state.depth_test_set('NONE')
-                    gpu.state.depth_mask_set(False)
-                    gpu.state.face_culling_set(culling)
+                    util.set_overlay_pass_state(w, h, culling)
                     shader = self.prepass_prog
                     self._set_view(shader, view, prepass=True)
                     shader.image("layer_count", self.layer_count)
@@ -176,12 +166,9 @@ class ScatterBaker(util.GPUPass):
             else:
                 depth_prepass(self.depth_fb, self.all_batch, view, culling)
             with self.splat_fb.bind():
-                gpu.state.viewport_set(0, 0, w, h)
-                gpu.state.depth_test_set('NONE')
-                gpu.state.depth_mask_set(False)
                 # Target faces turned away from the light add nothing (cos <= 0): cull them
                 # instead of rasterizing and discarding. Front = counter-clockwise = facing it.
-                gpu.state.face_culling_set('BACK')
+                util.set_overlay_pass_state(w, h, 'BACK')
                 shader = self.splat_prog
                 self._set_view(shader, view)
                 shader.image("accum", self.accum)

@@ -81,3 +81,22 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
         shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
         batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
+
+
+class LightViewBaker(util.GPUPass):
+    """Base of the bake passes: owns the plan's batches (target alone, target + occluders)
+    and checks GPU limits before anything is allocated. Subclasses define bytes_needed."""
+
+    @staticmethod
+    def bytes_needed(plan: BakePlan) -> int:
+        raise NotImplementedError
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        util.check_texture_limits(plan.settings.size, plan.max_view_side, cls.bytes_needed(plan))
+
+    def __init__(self, plan: BakePlan) -> None:
+        super().__init__()
+        self.plan = plan
+        self.all_batch = plan_batch(plan, with_occluders=True)
+        self.target_batch = plan_batch(plan, with_occluders=False)

@@ -148,6 +148,16 @@ def scoped_state() -> Iterator[None]:
         gpu.shader.unbind()
 
 
+def set_overlay_pass_state(width: int, height: int, culling: str = 'NONE', blend: str = 'NONE') -> None:
+    """State of a pass without depth buffer: viewport, no depth test or writes, culling and
+    blend as given. Call inside scoped_state()."""
+    gpu.state.viewport_set(0, 0, width, height)
+    gpu.state.depth_test_set('NONE')
+    gpu.state.depth_mask_set(False)
+    gpu.state.face_culling_set(culling)
+    gpu.state.blend_set(blend)
+
+
 def snapshot_state() -> tuple:
     """What scoped_state restores, for tests that check a pass left no state behind."""
     return (gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get(),
