@@ -123,7 +123,7 @@ def hao_runs(soup, size, method, directions_list, view_samples=2.0):
 
 
 def triangle_sweep(quick):
-    """Seconds per direction against triangle count (scatter, 1024^2, 64 directions)."""
+    """Seconds per direction against triangle count (default method: gather here; 1024^2, 64 directions)."""
     rows = []
     tess = [(32, 16), (64, 32), (128, 64), (256, 128)] if quick else [(32, 16), (64, 32), (128, 64), (256, 128), (512, 256)]
     plane = scenes.grid_plane(8.0, 16)

@@ -49,7 +49,7 @@ def main() -> int:
         lines.append("")
     sw = res.get("triangle_sweep")
     if sw:
-        lines.append("Cost against triangle count (scatter, 1024x1024, 64 directions, UV spheres over a plane):\n")
+        lines.append("Cost against triangle count (default method, i.e. the gather at unlimited distance; 1024x1024, 64 directions, UV spheres over a plane):\n")
         lines.append("| triangles | ms per direction |")
         lines.append("|---:|---:|")
         for r in sw:
