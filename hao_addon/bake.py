@@ -95,13 +95,16 @@ def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSett
          progress: Callable[[float], None] | None = None, use_cache: bool = True) -> BakeResult:
     """Blocking bake (drains bake_steps)."""
     steps = bake_steps(target, occluders, settings, use_cache)
-    while True:
-        try:
-            fraction = next(steps)
-        except StopIteration as stop:
-            return stop.value
-        if progress is not None:
-            progress(fraction)
+    try:
+        while True:
+            try:
+                fraction = next(steps)
+            except StopIteration as stop:
+                return stop.value
+            if progress is not None:
+                progress(fraction)
+    finally:
+        steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
 
 
 __all__ = ["BakeInputError", "BakeResult", "bake", "bake_steps", "clear_cache"]

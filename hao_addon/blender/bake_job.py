@@ -8,12 +8,11 @@ for meshes without UVs (the evaluated mesh must carry it); ``cancel`` removes it
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Generator
 
 import bpy
-import numpy as np
 
 from ..bake import BakeResult, bake_steps
 from ..core.imageio import format_for_path, write_ao_file
@@ -42,7 +41,6 @@ class BakeRequest:
     image_name: str = ""
     filepath: str = ""
     wire_material: bool = False
-    extra_occluders: list = field(default_factory=list)
 
 
 def output_path_for(request: BakeRequest, obj) -> str:
@@ -130,7 +128,6 @@ class BakeJob:
             candidates += [o for o in bpy.context.selected_objects if o.type == 'MESH' and o not in candidates]
         else:
             candidates = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()]
-        candidates += list(self.request.extra_occluders)
         seen, out = set(), []
         for o in candidates:
             if o != target and o.name not in seen:
@@ -149,13 +146,16 @@ class BakeJob:
             target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name])
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None) for o in self._occluder_objects(obj)]
             gen = bake_steps(target, occluders, req.settings)
-            while True:
-                try:
-                    frac = next(gen)
-                except StopIteration as stop:
-                    result = stop.value
-                    break
-                yield (k + frac) / n, f"Baking AO of '{obj.name}' ({k + 1}/{n}): {frac * 100:.0f}%"
+            try:
+                while True:
+                    try:
+                        frac = next(gen)
+                    except StopIteration as stop:
+                        result = stop.value
+                        break
+                    yield (k + frac) / n, f"Baking AO of '{obj.name}' ({k + 1}/{n}): {frac * 100:.0f}%"
+            finally:
+                gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
             self.results.append((obj, uv_names[obj.name], result))
         self.finished = True
 
@@ -191,7 +191,3 @@ class BakeJob:
                 mesh.uv_layers.remove(layer)
         self.created_uv.clear()
         self.results.clear()
-
-
-def results_arrays(job: BakeJob) -> dict[str, np.ndarray]:
-    return {obj.name: result.ao for obj, _uv, result in job.results}

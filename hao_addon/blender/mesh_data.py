@@ -10,10 +10,6 @@ from ..core.geometry import TriangleSoup
 AO_UV_NAME = "AO_UV"
 
 
-def world_matrix(obj: bpy.types.Object) -> np.ndarray:
-    return np.array(obj.matrix_world, dtype=np.float64)
-
-
 def _mesh_arrays(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertex positions (V, 3), triangle vertex indices (F, 3), triangle loop indices (F, 3))."""
     mesh.calc_loop_triangles()
@@ -45,8 +41,7 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
         m = np.array(obj_eval.matrix_world, dtype=np.float64)
         world = co @ m[:3, :3].T + m[:3, 3]
         uvs = loop_uvs(mesh, uv_name)[tri_loops] if uv_name else None
-        return TriangleSoup(world[tri_verts], uvs, name=obj.name,
-                            meta={"loop_count": len(mesh.loops), "vertex_count": len(mesh.vertices)})
+        return TriangleSoup(world[tri_verts], uvs, name=obj.name)
     finally:
         obj_eval.to_mesh_clear()
 
@@ -73,7 +68,3 @@ def add_uv_layer(mesh: bpy.types.Mesh, name: str, tri_loops: np.ndarray, corner_
     if active >= 0:
         mesh.uv_layers.active_index = active
     return layer.name
-
-
-def is_bakeable_mesh(obj: bpy.types.Object) -> bool:
-    return obj is not None and obj.type == 'MESH'

@@ -2,7 +2,7 @@
 """Triangle-soup geometry shared by the bakers and the references (float64 numpy)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -19,7 +19,6 @@ class TriangleSoup:
     positions: np.ndarray
     uvs: np.ndarray | None = None
     name: str = "mesh"
-    meta: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=np.float64).reshape(-1, 3, 3)
@@ -66,8 +65,3 @@ def bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
     radius = float(np.sqrt(((pts - centre) ** 2).sum(axis=1).max()))
     return centre, radius
 
-
-def aabb_distance(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray) -> float:
-    """Euclidean gap between two axis-aligned boxes (0 when they overlap)."""
-    gap = np.maximum(0.0, np.maximum(lo_a - hi_b, lo_b - hi_a))
-    return float(np.sqrt((gap * gap).sum()))

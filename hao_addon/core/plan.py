@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .directions import bake_directions
-from .geometry import TriangleSoup, aabb_distance, bounding_sphere, face_normals_areas, uv_areas
+from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, uv_areas
 from .normalization import face_normalizers
 from .settings import BakeSettings
 from .views import OrthoView, fit_view
@@ -62,10 +62,7 @@ class BakePlan:
         omega = self.directions[index]
         jitter = np.random.default_rng((self.settings.seed, index)).random(2)
         c, r = self.drawn_sphere
-        w = float(omega @ c)
-        proj_w = self.target_points @ omega
-        return fit_view(omega, self.target_points, (float(proj_w.min()), w + r), self.pixel_size,
-                        jitter, self.max_view_side)
+        return fit_view(omega, self.target_points, float(omega @ c) + r, self.pixel_size, jitter, self.max_view_side)
 
 
 def _check_finite(soup: TriangleSoup) -> None:
@@ -108,23 +105,23 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
             continue
         p = occ.positions
         if settings.max_distance > 0.0:
-            if aabb_distance(p.reshape(-1, 3).min(0), p.reshape(-1, 3).max(0), lo_t, hi_t) > settings.max_distance:
-                culled_objects += 1
-                culled_faces += occ.face_count
-                continue
+            # Per triangle: the gap between its box and the target's box.
             gap = np.maximum(0.0, np.maximum(p.min(axis=1) - hi_t, lo_t - p.max(axis=1)))
             near = np.sqrt((gap * gap).sum(axis=1)) <= settings.max_distance
             culled_faces += int((~near).sum())
+            if not near.any():
+                culled_objects += 1
+                continue
             p = p[near]
         drawn_objects += 1
         occ_parts.append((p - centre) / scale)
     o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
-    o_normals, _ = face_normals_areas(o_pos) if len(o_pos) else (np.zeros((0, 3)), None)
+    o_normals, _ = face_normals_areas(o_pos)
 
     directions = bake_directions(settings.directions, settings.seed)
     s_f = face_normalizers(normals, directions, settings.weighting)
-    inv_s = np.where(s_f > 0.0, 1.0 / np.where(s_f > 0.0, s_f, 1.0), 0.0)
-    inv_s[areas <= 0.0] = 0.0  # zero-area faces cover no surface
+    # Faces no direction sees, and zero-area faces (no surface), contribute nothing.
+    inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
 
     # Light-view pixel size from the texel density: world area per texel on each face.
     size = settings.size

@@ -40,13 +40,14 @@ def light_basis(omega: np.ndarray) -> np.ndarray:
     return np.stack([u, v, w])
 
 
-def fit_view(omega: np.ndarray, target_points: np.ndarray, depth_points_lohi: tuple[float, float] | None,
+def fit_view(omega: np.ndarray, target_points: np.ndarray, light_reach: float | None,
              pixel_size: float, jitter: np.ndarray, max_side: int) -> OrthoView:
     """Orthographic view looking along -omega that covers target_points (n, 3).
 
     The window is the tight projected box of the target (pixels elsewhere cannot hold a target
-    texel, so they are never rasterized); the depth range spans depth_points_lohi (the range of
-    w . p over everything drawn) so occluders between the target and the light are kept.
+    texel, so they are never rasterized); the depth range runs from the target's farthest point
+    to light_reach (the largest w . p over everything drawn, None = the target's own), so
+    occluders between the target and the light are kept.
     jitter: (2,) in [0, 1) pixel offset, decorrelating the pixel grids of successive views.
     """
     basis = light_basis(omega)
@@ -56,7 +57,9 @@ def fit_view(omega: np.ndarray, target_points: np.ndarray, depth_points_lohi: tu
     size = np.ceil((hi - lo) / pixel_size).astype(int)
     width, height = (int(min(max(s, 1), max_side)) for s in size)
     hi = lo + np.array([width, height]) * pixel_size  # square pixels exactly
-    zlo, zhi = depth_points_lohi if depth_points_lohi is not None else (proj[:, 2].min(), proj[:, 2].max())
+    zlo, zhi = float(proj[:, 2].min()), float(proj[:, 2].max())
+    if light_reach is not None:
+        zhi = max(zhi, light_reach)
     pad = 1e-3 * max(zhi - zlo, 1e-6)
     zlo, zhi = zlo - pad, zhi + pad
     # NDC: x, y in [-1, 1] over the window; depth: w = zhi (nearest the light) -> -1, zlo -> +1.

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
-from .light_view import LightViewBaker, depth_prepass, soup_shader_info
+from .light_view import LightViewBaker, bind_light_view, depth_prepass, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 
@@ -45,10 +45,10 @@ class GatherBaker(LightViewBaker):
         side = plan.max_view_side
         return plan.settings.size**2 * 16 + side * side * 8
 
-    def __init__(self, plan: BakePlan) -> None:
+    def _allocate(self) -> None:
+        plan = self.plan
         if plan.settings.max_distance > 0.0:
             raise ValueError("the gather baseline supports only unlimited distance")
-        super().__init__(plan)
         size, side = plan.settings.size, plan.max_view_side
         self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
@@ -58,11 +58,11 @@ class GatherBaker(LightViewBaker):
         with self.accum_fb.bind():
             gpu.state.active_framebuffer_get().clear(color=(0.0, 0.0, 0.0, 0.0))
         self.gather_prog = gather_shader(plan.settings.weighting == "uniform")
-        self.stats = dict(view_pixels=0, directions_done=0, uv_fragments_per_direction=size * size)
+        self.stats = dict(view_pixels=0, directions_done=0)
 
     def _release(self) -> None:
-        self.all_batch = self.target_batch = self.depth = self.dummy = None
-        self.depth_fb = self.accum = self.accum_fb = None
+        self.depth = self.dummy = self.depth_fb = self.accum = self.accum_fb = None
+        super()._release()
 
     def run_direction(self, index: int) -> None:
         plan = self.plan
@@ -76,10 +76,7 @@ class GatherBaker(LightViewBaker):
             with self.accum_fb.bind():
                 util.set_overlay_pass_state(size, size, blend='ADDITIVE_PREMULT')  # exact ONE, ONE sums
                 shader = self.gather_prog
-                shader.bind()
-                shader.uniform_float("view_proj", view.matrix.T.ravel())
-                shader.uniform_float("omega", (*view.omega, 0.0))
-                shader.uniform_float("tex_size", (size, size))
+                bind_light_view(shader, view, size)
                 shader.uniform_int("view_size", (w, h))
                 shader.uniform_float("pixel_depth", view.pixel_size / (view.depth_far - view.depth_near))
                 shader.uniform_sampler("depth_tex", self.depth)

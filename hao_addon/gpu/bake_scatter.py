@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.plan import BakePlan
 from . import util
-from .light_view import RASTER_VARYINGS, LightViewBaker, depth_prepass, soup_shader_info
+from .light_view import RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, soup_shader_info
 from .shaders import cached_shader, glsl_source
 
 CHUNK_DIRECTIONS = 16
@@ -37,8 +37,9 @@ DEPTH_TOLERANCE = 2.0**-21
 # Depth layers kept per light-view pixel for max-distance bakes. A ray through a closed mesh
 # crosses an even number of surfaces; 16 holds eight nested shells. Overflow is counted.
 LAYERS = 16
-# Largest split of one pixel's UV footprint per axis (8 x 8 sub-splats); beyond that the UV
-# layout is over 8 texels per light-view pixel and the bake warns to raise view samples.
+# Largest split of one pixel's UV footprint per axis (8 x 8 sub-splats). Texels more than
+# 12 times smaller than a light-view pixel per side may then get no sample in a direction;
+# their coverage drops and seam repair treats them as rim texels.
 MAX_FOOTPRINT = 8
 
 
@@ -96,8 +97,8 @@ class ScatterBaker(LightViewBaker):
         per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
         return plan.settings.size**2 * 4 + side * side * per_pixel
 
-    def __init__(self, plan: BakePlan) -> None:
-        super().__init__(plan)
+    def _allocate(self) -> None:
+        plan = self.plan
         settings = plan.settings
         size = settings.size
         side = plan.max_view_side
@@ -129,17 +130,10 @@ class ScatterBaker(LightViewBaker):
                           footprint_splat=plan.needs_footprint_splat, max_chunk_fill=0.0)
 
     def _release(self) -> None:
-        self.all_batch = self.target_batch = None
         self.accum = self.depth = self.dummy = None
         self.layer_count = self.layer_depth = self.overflow = None
         self.depth_fb = self.splat_fb = None
-
-    def _set_view(self, shader, view, prepass: bool = False) -> None:
-        shader.bind()
-        shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
-        if not prepass:  # the pre-pass programs' compilers drop the unused uniforms
-            shader.uniform_float("omega", (*view.omega, 0.0))
-            shader.uniform_float("tex_size", (self.plan.settings.size, self.plan.settings.size))
+        super()._release()
 
     def run_direction(self, index: int) -> None:
         """Render light view `index` and splat its target fragments into the accumulators."""
@@ -157,7 +151,7 @@ class ScatterBaker(LightViewBaker):
                 with self.splat_fb.bind():
                     util.set_overlay_pass_state(w, h, culling)
                     shader = self.prepass_prog
-                    self._set_view(shader, view, prepass=True)
+                    bind_light_view(shader, view, plan.settings.size, prepass=True)
                     shader.image("layer_count", self.layer_count)
                     shader.image("layer_depth", self.layer_depth)
                     shader.image("overflow", self.overflow)
@@ -170,7 +164,7 @@ class ScatterBaker(LightViewBaker):
                 # instead of rasterizing and discarding. Front = counter-clockwise = facing it.
                 util.set_overlay_pass_state(w, h, 'BACK')
                 shader = self.splat_prog
-                self._set_view(shader, view)
+                bind_light_view(shader, view, plan.settings.size)
                 shader.image("accum", self.accum)
                 shader.uniform_float("fixed_scale", self.fixed_scale)
                 shader.uniform_float("depth_tolerance", DEPTH_TOLERANCE)
@@ -203,11 +197,11 @@ class ScatterBaker(LightViewBaker):
                 self.chunk //= 2  # stacked UV islands: keep later chunks far from overflow
             self.den += den.astype(np.float64) / self.fixed_scale
             self.num += (packed & 0xFFFF).astype(np.float64) / self.fixed_scale
-            if self.layered:
-                self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
             self.pending = 0
 
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
         """(numerator, denominator), each (size, size) float64, over the directions so far."""
         self.flush()
+        if self.layered:  # pixels whose depth list overflowed, counted over the whole bake
+            self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
         return self.num, self.den

@@ -58,6 +58,17 @@ def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
     return util.make_batch('TRIS', {"pos": ('F32', pos), "uv": ('F32', uv), "face": ('F32', face)})
 
 
+def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = False) -> None:
+    """Bind `shader` and set the light-view push constants of soup_shader_info. Pre-pass
+    programs use only view_proj (their compilers drop the others, and setting a dropped
+    uniform raises)."""
+    shader.bind()
+    shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
+    if not prepass:
+        shader.uniform_float("omega", (*view.omega, 0.0))
+        shader.uniform_float("tex_size", (map_size, map_size))
+
+
 def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
     """Clear the view's sub-rectangle and draw `batch` depth-only from the light.
 
@@ -77,15 +88,15 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
         gpu.state.depth_mask_set(True)
         gpu.state.face_culling_set(culling)
         gpu.state.color_mask_set(False, False, False, False)
-        shader.bind()
-        shader.uniform_float("view_proj", view.matrix.T.ravel())  # column-major for GLSL
+        bind_light_view(shader, view, 0, prepass=True)
         batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
 
 
 class LightViewBaker(util.GPUPass):
     """Base of the bake passes: owns the plan's batches (target alone, target + occluders)
-    and checks GPU limits before anything is allocated. Subclasses define bytes_needed."""
+    and checks GPU limits before anything is allocated. Subclasses define bytes_needed and
+    _allocate; if allocation fails part-way, what was made is freed before the error leaves."""
 
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:
@@ -98,5 +109,17 @@ class LightViewBaker(util.GPUPass):
     def __init__(self, plan: BakePlan) -> None:
         super().__init__()
         self.plan = plan
-        self.all_batch = plan_batch(plan, with_occluders=True)
-        self.target_batch = plan_batch(plan, with_occluders=False)
+        try:
+            self.all_batch = plan_batch(plan, with_occluders=True)
+            self.target_batch = plan_batch(plan, with_occluders=False)
+            self._allocate()
+        except BaseException:
+            self.free()
+            raise
+
+    def _allocate(self) -> None:
+        raise NotImplementedError
+
+    def _release(self) -> None:
+        """Subclasses drop their own textures and framebuffers, then call this."""
+        self.all_batch = self.target_batch = None

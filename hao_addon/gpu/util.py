@@ -40,11 +40,6 @@ class GPUPass:
     def _release(self) -> None:  # overridden
         pass
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.free()
 
 
 # Refuse bakes whose textures would exceed this (bytes); the gpu module cannot query free
@@ -118,12 +113,6 @@ def image_barrier() -> None:
     shader = cached_shader(("barrier",), build)
     gpu.compute.dispatch(shader, 1, 1, 1)
     gpu.shader.unbind()
-
-
-def sync(tex: "gpu.types.GPUTexture") -> None:
-    """Block until queued GPU work is done (there is no gpu.finish): read one texel."""
-    with gpu.types.GPUFrameBuffer(color_slots=tex).bind():
-        gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 1, 0, 'FLOAT')
 
 
 @contextlib.contextmanager
