@@ -178,3 +178,16 @@ def test_analytic_formulas():
     # Wendland quadrature against the step version's limit: w <= step, so A_wendland >= A_step.
     x = np.array([0.1, 0.4, 0.8])
     assert np.all(scenes.wall_accessibility(x, 1.0, "wendland") >= scenes.wall_accessibility(x, 1.0, "none"))
+
+
+def test_closed_surface_detection():
+    from hao_addon.core.geometry import is_closed_surface
+    from hao_addon.core import scenes
+    torus = scenes.torus(1.0, 0.4, (0, 0, 0), 24, 12).positions
+    assert is_closed_surface(torus)
+    assert is_closed_surface(np.concatenate([torus, torus + 3.0]))  # separate closed parts
+    assert not is_closed_surface(torus[1:])  # a hole
+    assert not is_closed_surface(np.concatenate([torus[:1, ::-1], torus[1:]]))  # one flipped face
+    assert not is_closed_surface(np.concatenate([torus, torus[:1]]))  # a duplicated face (fin)
+    assert not is_closed_surface(scenes.grid_plane(2.0, 4).positions)  # open sheet
+    assert not is_closed_surface(np.zeros((0, 3, 3)))

@@ -35,6 +35,7 @@ def test_every_shader_variant_compiles(gpu_context):
                 for footprint in (False, True):
                     bake_scatter.splat_shader(uniform, layered, wendland, footprint)
         bake_gather.gather_shader(uniform)
+        bake_gather.texel_list_shader(fill=uniform)
     # Every file in gpu_shaders/ is used by some pass (no dead shader text ships).
     sources = "".join(p.read_text() for p in (shaders.SHADER_DIR.parent / "hao_addon").rglob("*.py"))
     for path in shaders.SHADER_DIR.iterdir():

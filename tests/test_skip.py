@@ -58,3 +58,37 @@ def test_rebake_with_unchanged_input_is_cached(gpu_context):
     moved = TriangleSoup(sphere.positions + [0, 0, 1e-4], None)
     assert not bake(plane, [moved], s).stats["cache_hit"]
     assert not bake(plane, [sphere], BakeSettings(size=256, directions=129)).stats["cache_hit"]
+
+
+def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
+    """Everything drawn is closed: the scatter's light-view depth maps draw only light-facing
+    faces (the first surface a light ray meets is always one), and the map equals the one
+    from drawing every face."""
+    import dataclasses
+
+    from hao_addon.core.plan import make_plan
+    from hao_addon.core.seams import finalize_map
+    from hao_addon.gpu import baker_for
+
+    torus = scenes.torus(1.0, 0.45, (0, 0, 0), 48, 24)
+    tilted = TriangleSoup(torus.positions @ np.array([[1, 0, 0], [0, 0.8, 0.6], [0, -0.6, 0.8]]), torus.uvs)
+    method = "scatter"
+    plan = make_plan(tilted, [], BakeSettings(size=128, directions=32, margin=0, method=method))
+    assert plan.closed_surfaces and plan.depth_map_culls_back_faces and plan.stats["closed_surfaces"]
+    maps = []
+    for p in (plan, dataclasses.replace(plan, closed_surfaces=False)):
+        baker = baker_for(method)(p)
+        try:
+            for i in range(p.settings.directions):
+                baker.run_direction(i)
+            maps.append(finalize_map(*baker.accumulated(), 0))
+        finally:
+            baker.free()
+    (culled, covered, _), (full, covered_full, _) = maps
+    np.testing.assert_array_equal(covered, covered_full)
+    assert 0.3 < culled[covered].min() and culled[covered].mean() < 0.97  # the hole shades the inner ring
+    assert np.abs(culled - full)[covered].max() < 1e-4
+    # An open occluder (a plane) or a max distance keeps every face in the depth maps.
+    plane = scenes.grid_plane(4.0, 4, z=-0.5)
+    assert not make_plan(tilted, [plane], BakeSettings(size=64, directions=8)).depth_map_culls_back_faces
+    assert not make_plan(tilted, [], BakeSettings(size=64, directions=8, max_distance=1.0)).depth_map_culls_back_faces

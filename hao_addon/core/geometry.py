@@ -65,3 +65,31 @@ def bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
     radius = float(np.sqrt(((pts - centre) ** 2).sum(axis=1).max()))
     return centre, radius
 
+
+
+def is_closed_surface(positions: np.ndarray) -> bool:
+    """True when (F, 3, 3) triangles form closed, consistently oriented surfaces: after
+    welding bit-identical corner positions, every directed edge a->b occurs exactly once and
+    its reverse b->a exactly once (no border, no fin, no flipped face).
+
+    Why it matters: seen from outside, the first surface a ray meets on a closed surface is
+    always an entry, i.e. faces the viewer, so a depth map of the front faces alone equals the
+    depth map of all faces, and back faces need not be drawn (about 40 % of a light view's
+    rasterization cost on llvmpipe). Separate closed objects, touching or intersecting, keep
+    the property.
+    """
+    corners = np.ascontiguousarray(np.asarray(positions, dtype=np.float64).reshape(-1, 3))
+    if len(corners) == 0:
+        return False
+    keys = corners.view(np.dtype((np.void, corners.dtype.itemsize * 3))).ravel()
+    _, vertex = np.unique(keys, return_inverse=True)
+    tri = vertex.reshape(-1, 3).astype(np.int64)
+    a = tri.ravel()
+    b = np.roll(tri, -1, axis=1).ravel()
+    if (a == b).any():  # a collapsed edge has no partner
+        return False
+    n = int(vertex.max()) + 1
+    forward = np.sort(a * n + b)
+    if (np.diff(forward) == 0).any():  # a directed edge used twice: fin or flipped neighbour
+        return False
+    return bool(np.array_equal(forward, np.sort(b * n + a)))

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .directions import bake_directions
-from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, uv_areas
+from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, is_closed_surface, uv_areas
 from .normalization import face_normalizers
 from .settings import BakeSettings
 from .views import OrthoView, fit_view
@@ -51,7 +51,19 @@ class BakePlan:
     target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
     drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
     needs_footprint_splat: bool = False
+    closed_surfaces: bool = False  # everything drawn is closed and consistently oriented
     stats: dict = field(default_factory=dict)
+
+    @property
+    def depth_map_culls_back_faces(self) -> bool:
+        """Whether a nearest-surface depth map from a light may skip faces turned away from
+        it: when the user ignores back faces, and, with unlimited distance, when everything
+        drawn is closed (the first surface a light ray meets is then always a light-facing
+        one, so the map is unchanged). With a max distance the back face where a ray enters
+        an occluder can lie within reach while its exit does not, so it must stay. Used by
+        the scatter, which compares a fragment with the map at its own pixel; the gather keeps
+        back faces (see bake_gather.py)."""
+        return self.settings.ignore_back_faces or (self.closed_surfaces and self.settings.max_distance == 0.0)
 
     @property
     def max_distance_normalized(self) -> float:
@@ -142,6 +154,9 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
     drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
+    # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
+    closed = (settings.max_distance == 0.0 and not settings.ignore_back_faces
+              and is_closed_surface(np.concatenate([target.positions] + [o.positions for o in occluders if o.face_count])))
     drawn_sphere = bounding_sphere(drawn)
     target_points = np.unique(t_pos.reshape(-1, 3), axis=0) if len(t_pos) < 2_000_000 else t_pos.reshape(-1, 3)
 
@@ -149,9 +164,9 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
                  occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
-                 dense_uv_area_fraction=dense_fraction)
+                 dense_uv_area_fraction=dense_fraction, closed_surfaces=closed)
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32),
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
                     pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere,
-                    dense_fraction > DENSE_AREA_LIMIT, stats)
+                    dense_fraction > DENSE_AREA_LIMIT, closed, stats)

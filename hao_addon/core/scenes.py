@@ -55,6 +55,29 @@ def uv_sphere(radius: float, centre, segments: int = 64, rings: int = 32, name: 
     return TriangleSoup(np.array(tris) * radius + np.asarray(centre, float), np.array(tuv), name=name)
 
 
+def torus(major: float, minor: float, centre, segments: int = 48, sides: int = 24,
+          name: str = "torus") -> TriangleSoup:
+    """Closed torus around the z axis (outward normals, counter-clockwise). Corners come
+    from one shared vertex array, so welded positions are bit-identical across the UV seams
+    and the surface tests as closed; UVs wrap once around each circle."""
+    u = np.arange(segments) * (2.0 * np.pi / segments)
+    v = np.arange(sides) * (2.0 * np.pi / sides)
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    ring = major + minor * np.cos(vv)
+    verts = np.stack([ring * np.cos(uu), ring * np.sin(uu), minor * np.sin(vv)], axis=-1)
+    i, j = np.meshgrid(np.arange(segments), np.arange(sides), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    i1, j1 = (i + 1) % segments, (j + 1) % sides
+    quad = lambda a, b: verts[a, b]  # noqa: E731
+    uvq = lambda a, b: np.stack([a / segments, b / sides], axis=-1)  # noqa: E731
+    # (i, j) -> (i+1, j) -> (i+1, j+1) is counter-clockwise seen from outside.
+    pos = np.concatenate([np.stack([quad(i, j), quad(i1, j), quad(i1, j1)], 1),
+                          np.stack([quad(i, j), quad(i1, j1), quad(i, j1)], 1)])
+    uv = np.concatenate([np.stack([uvq(i, j), uvq(i + 1, j), uvq(i + 1, j + 1)], 1),
+                         np.stack([uvq(i, j), uvq(i + 1, j + 1), uvq(i, j + 1)], 1)])
+    return TriangleSoup(pos + np.asarray(centre, float), uv, name=name)
+
+
 def wall(width: float, height: float, x: float, name: str = "wall") -> TriangleSoup:
     """Vertical rectangle in the plane x = const, facing -x (towards the floor at x < wall),
     spanning y in [-width/2, width/2], z in [0, height]."""

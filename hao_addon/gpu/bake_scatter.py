@@ -144,6 +144,7 @@ class ScatterBaker(LightViewBaker):
         # exactly when that face looks towards the light, i.e. faces the light camera. So the
         # pre-pass culls FRONT faces; the splat pass draws only light-facing target faces.
         culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
+        prepass_culling = 'FRONT' if plan.depth_map_culls_back_faces else 'NONE'
         with util.scoped_state():
             gpu.state.blend_set('NONE')
             if self.layered:
@@ -158,7 +159,7 @@ class ScatterBaker(LightViewBaker):
                     self.all_batch.draw(shader)
                 util.image_barrier()  # the splat pass reads the lists with imageLoad
             else:
-                depth_prepass(self.depth_fb, self.all_batch, view, culling)
+                depth_prepass(self.depth_fb, self.all_batch, view, prepass_culling)
             with self.splat_fb.bind():
                 # Target faces turned away from the light add nothing (cos <= 0): cull them
                 # instead of rasterizing and discarding. Front = counter-clockwise = facing it.

@@ -1,0 +1,9 @@
+/* Texel list of the shadow-map gather: the target rasterized once in UV space, one fragment
+ * per covered texel centre, carrying the surface point and its face.
+ * pos: normalized world position; uv: UV in [0, 1]; face: unit normal, 1 / S_f. */
+void main()
+{
+  world_pos = pos;
+  face_data = face;
+  gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+}
