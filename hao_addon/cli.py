@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Command line: ``python -m hao_addon bake INPUT --size N --directions D --out FILE ...``.
+"""Command line: ``python -m hao_addon bake INPUT --size N --directions D --out FILE ...`` and
+``python -m hao_addon render-ao INPUT.blend --camera NAME --width W --height H --out FILE ...``.
 
 The same entry point is registered as a Blender command (``blender -c hao bake ...``).
 Exit codes: 0 done, 2 bad arguments or input, 3 no usable GPU, 1 anything unexpected.
@@ -48,6 +49,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="'target': self-occlusion only; 'visible': every visible mesh occludes (default)")
     b.add_argument("--seed", type=int, default=0)
     b.add_argument("--quiet", action="store_true")
+
+    r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
+    r.add_argument("input", help=".blend file (or .obj/.glb: then --camera is required to exist in it)")
+    r.add_argument("--out", required=True, help="output .png (16-bit RGBA) or .exr (32-bit float RGBA)")
+    r.add_argument("--camera", default="", help="camera object (default: the scene camera)")
+    r.add_argument("--width", type=int, default=800)
+    r.add_argument("--height", type=int, default=600)
+    r.add_argument("--rays", type=int, default=32, help="rays per AO-map pixel (default 32)")
+    r.add_argument("--steps", type=int, default=8, help="fixed steps per ray (default 8)")
+    r.add_argument("--spread", type=float, default=1.0, help="ray cone, 1 = hemisphere (default 1)")
+    r.add_argument("--max-distance", type=float, default=1.0, help="d_max in scene units (default 1)")
+    r.add_argument("--grid", type=int, default=256, help="voxels along the longest side, 64..512 (default 256)")
+    r.add_argument("--scale", type=int, default=2, help="AO map is 1/scale of the image per axis (default 2)")
+    r.add_argument("--filter", type=int, default=16, help="bilateral filter size in pixels (default 16)")
+    r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
+    r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
+    r.add_argument("--quiet", action="store_true")
     return parser
 
 
@@ -123,12 +141,45 @@ def run_bake(args) -> int:
     return EXIT_OK
 
 
+def run_render_ao(args) -> int:
+    import bpy
+
+    from .core.imageio import format_for_path, write_ao_file
+    from .core.view_settings import ViewAOSettings
+    from .render_ao import render_camera_ao
+
+    out = Path(args.out).resolve()
+    format_for_path(out)  # bad extension: fail before loading anything
+    load_scene(Path(args.input))
+    scene = bpy.context.scene
+    if args.frame is not None:
+        scene.frame_set(args.frame)
+    if args.camera:
+        camera = bpy.data.objects.get(args.camera)
+        if camera is None or camera.type != 'CAMERA':
+            cams = sorted(o.name for o in bpy.data.objects if o.type == 'CAMERA')
+            raise CLIError(f"no camera named '{args.camera}' (cameras: {', '.join(cams) or 'none'})")
+    else:
+        camera = scene.camera
+    settings = ViewAOSettings(rays=args.rays, steps=args.steps, spread=args.spread, max_distance=args.max_distance,
+                              grid=args.grid, scale=args.scale, filter_size=args.filter)
+    t0 = time.perf_counter()
+    rgba = render_camera_ao(scene, camera, args.width, args.height, settings, skip_baked=args.skip_baked)
+    write_ao_file(out, rgba)
+    if not args.quiet:
+        print(f"hao: rendered AO from '{camera.name}' {args.width}x{args.height} in "
+              f"{time.perf_counter() - t0:.2f} s -> {out}")
+    return EXIT_OK
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = build_parser().parse_args(argv)
         if args.command == "bake":
             return run_bake(args)
+        if args.command == "render-ao":
+            return run_render_ao(args)
         raise CLIError(f"unknown command {args.command}")
     except CLIError as exc:
         print(f"hao: error: {exc}", file=sys.stderr)

@@ -48,5 +48,42 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
 
 
-classes = (VIEW3D_PT_hao_bake,)
+class VIEW3D_PT_hao_view(bpy.types.Panel):
+    """Hybrid Ambient Occlusion in the viewport and from the camera"""
+
+    bl_label = "Viewport AO (HAO)"
+    bl_idname = "VIEW3D_PT_hao_view"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "AO"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.hao_view, "enabled", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        props = context.scene.hao_view
+        col = layout.column()
+        col.prop(props, "rays")
+        col.prop(props, "steps")
+        col.prop(props, "spread")
+        col.prop(props, "max_distance")
+        col.prop(props, "grid")
+        col.prop(props, "scale")
+        col.prop(props, "filter_size")
+        col.prop(props, "strength")
+        col.separator()
+        col.prop(props, "region_mode")
+        if props.region_mode == 'COLLECTION':
+            col.prop(props, "region_collection")
+        elif props.region_mode == 'BOX':
+            col.prop(props, "region_object")
+        col.prop(props, "skip_baked")
+        layout.separator()
+        layout.operator("render.hao_render_ao", icon='RENDER_STILL')
+
+
+classes = (VIEW3D_PT_hao_bake, VIEW3D_PT_hao_view)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -20,6 +20,7 @@ from ..core.plan import BakeInputError
 from ..core.settings import BakeSettings
 from ..core.unwrap import xatlas_unwrap
 from . import images, mesh_data
+from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
 
@@ -178,6 +179,7 @@ class BakeJob:
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
             existing = req.image or bpy.data.images.get(name)
             image = images.store_ao_image(result.ao, name, existing)
+            obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
             self.committed.append(image)

@@ -93,3 +93,18 @@ def is_closed_surface(positions: np.ndarray) -> bool:
     if (np.diff(forward) == 0).any():  # a directed edge used twice: fin or flipped neighbour
         return False
     return bool(np.array_equal(forward, np.sort(b * n + a)))
+
+
+def boundary_edge_fraction(positions: np.ndarray) -> float:
+    """Fraction of the (welded, undirected) edges of (F, 3, 3) triangles that belong to one
+    face only: 0 for a closed surface, small for a scan with a few holes, large for sheets."""
+    corners = np.ascontiguousarray(np.asarray(positions, dtype=np.float64).reshape(-1, 3))
+    if len(corners) == 0:
+        return 1.0
+    keys = corners.view(np.dtype((np.void, corners.dtype.itemsize * 3))).ravel()
+    _, vertex = np.unique(keys, return_inverse=True)
+    tri = vertex.reshape(-1, 3).astype(np.int64)
+    a, b = tri.ravel(), np.roll(tri, -1, axis=1).ravel()
+    n = int(vertex.max()) + 1
+    _, counts = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
+    return float((counts == 1).sum() / len(counts))

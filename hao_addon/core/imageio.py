@@ -43,28 +43,41 @@ def _atomic_write(path: Path, data: bytes) -> None:
 
 
 def png16_bytes(image: np.ndarray) -> bytes:
-    """16-bit grayscale PNG of image (H, W) in [0, 1], row 0 = bottom."""
+    """16-bit PNG of image (H, W) gray or (H, W, 4) RGBA in [0, 1], row 0 = bottom."""
     img = np.clip(np.nan_to_num(np.asarray(image, np.float64)), 0.0, 1.0)
-    h, w = img.shape
+    h, w = img.shape[:2]
+    channels = 1 if img.ndim == 2 else img.shape[2]
+    if channels not in (1, 4):
+        raise ValueError(f"PNG writer takes gray or RGBA images, got {channels} channels")
     q = np.round(img[::-1] * 65535.0).astype(">u2")  # flip to top-first, big-endian samples
-    raw = np.concatenate([np.zeros((h, 1), np.uint8), q.view(np.uint8).reshape(h, 2 * w)], axis=1)
+    row_bytes = 2 * w * channels
+    raw = np.concatenate([np.zeros((h, 1), np.uint8), q.view(np.uint8).reshape(h, row_bytes)], axis=1)
 
     def chunk(tag: bytes, payload: bytes) -> bytes:
         return struct.pack(">I", len(payload)) + tag + payload + struct.pack(">I", zlib.crc32(tag + payload))
 
-    ihdr = struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)  # depth 16, colour type 0 (gray)
+    colour_type = 0 if channels == 1 else 6  # gray or RGBA
+    ihdr = struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0)
     return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)) + chunk(b"IEND", b"")
 
 
 def exr32_bytes(image: np.ndarray) -> bytes:
-    """Single-channel ('Y') 32-bit float scanline OpenEXR, uncompressed, row 0 = bottom."""
-    img = np.ascontiguousarray(np.asarray(image, np.float32)[::-1])
-    h, w = img.shape
+    """32-bit float scanline OpenEXR, uncompressed, row 0 = bottom: channel 'Y' for (H, W),
+    channels A, B, G, R (EXR stores them sorted by name) for (H, W, 4) RGBA."""
+    img = np.asarray(image, np.float32)[::-1]
+    h, w = img.shape[:2]
+    if img.ndim == 2:
+        names, planes = ["Y"], [img]
+    elif img.shape[2] == 4:
+        names, planes = ["A", "B", "G", "R"], [img[..., 3], img[..., 2], img[..., 1], img[..., 0]]
+    else:
+        raise ValueError(f"EXR writer takes gray or RGBA images, got {img.shape[2]} channels")
 
     def attr(name: str, kind: str, payload: bytes) -> bytes:
         return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(payload)) + payload
 
-    channels = b"Y\0" + struct.pack("<iBxxxii", 2, 0, 1, 1) + b"\0"  # FLOAT, linear 0, sampling 1 1
+    # FLOAT (2), linear 0, sampling 1 1 per channel
+    channels = b"".join(n.encode() + b"\0" + struct.pack("<iBxxxii", 2, 0, 1, 1) for n in names) + b"\0"
     header = (struct.pack("<ii", 20000630, 2)
               + attr("channels", "chlist", channels)
               + attr("compression", "compression", b"\0")
@@ -75,19 +88,22 @@ def exr32_bytes(image: np.ndarray) -> bytes:
               + attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
               + attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
               + b"\0")
-    line_bytes = 4 * w
+    line_bytes = 4 * w * len(names)
     block = 8 + line_bytes
     start = len(header) + 8 * h
     offsets = struct.pack(f"<{h}Q", *(start + i * block for i in range(h)))
     rows = np.empty((h, block), np.uint8)
     rows[:, 0:4] = np.arange(h, dtype="<i4").view(np.uint8).reshape(h, 4)
     rows[:, 4:8] = np.frombuffer(struct.pack("<i", line_bytes), np.uint8)
-    rows[:, 8:] = img.astype("<f4").view(np.uint8).reshape(h, line_bytes)
+    # Within a scanline, each channel's samples follow one another, in channel-name order.
+    data = np.stack([np.ascontiguousarray(p, dtype="<f4") for p in planes], axis=1)  # (h, c, w)
+    rows[:, 8:] = data.view(np.uint8).reshape(h, line_bytes)
     return header + offsets + rows.tobytes()
 
 
 def write_ao_file(path: str | Path, image: np.ndarray) -> None:
-    """Write (H, W) accessibility to .png (16-bit) or .exr (32-bit float), atomically."""
+    """Write (H, W) accessibility, or (H, W, 4) RGBA, to .png (16-bit) or .exr (32-bit
+    float), atomically."""
     fmt = format_for_path(path)
     if not np.isfinite(image).all():
         raise ValueError("refusing to write an AO map containing NaN or Inf")

@@ -47,7 +47,9 @@ def uv_sphere(radius: float, centre, segments: int = 64, rings: int = 32, name: 
         for s in range(segments):
             a, b, c, d = (r, s), (r + 1, s), (r + 1, s + 1), (r, s + 1)
             for tri in ((a, b, c), (a, c, d)):
-                p = np.array([pts[k] for k in tri])
+                # Welded: the seam column and each pole share bit-identical positions,
+                # so the sphere is closed (core.geometry.is_closed_surface).
+                p = np.array([pts[k[0], 0 if k[0] in (0, rings) else k[1] % segments] for k in tri])
                 if np.linalg.norm(np.cross(p[1] - p[0], p[2] - p[0])) < 1e-12:
                     continue  # pole triangles collapse
                 tris.append(p)
@@ -134,4 +136,30 @@ def finite_wall_accessibility(distance_to_wall: np.ndarray, lateral: np.ndarray,
         t = xi / b
         hit = (np.abs(yi + a * t) <= width / 2) & (up * t <= height)
         out[i] = 1.0 - hit.sum() * cell / np.pi
+    return out
+
+
+def sphere_on_plane_kernel_accessibility(rho: np.ndarray, radius: float, max_distance: float,
+                                         quadrature: int = 256) -> np.ndarray:
+    """Accessibility of plane points at horizontal distance rho from the contact point of a
+    sphere of `radius` resting on the plane, with the Wendland kernel on the hit distance
+    (support max_distance): 1 - (1/pi) int w(t(omega)) cos dA over the hemisphere, with the
+    exact ray-sphere distance t and a quadrature x quadrature midpoint rule on Malley's disk
+    (cosine-weighted). With w = 1 (max_distance -> inf) it reduces to 1 - (R/D)^3."""
+    rho = np.atleast_1d(np.asarray(rho, np.float64))
+    k = (np.arange(quadrature) + 0.5) / quadrature
+    r = np.sqrt(k)[:, None]
+    phi = 2.0 * np.pi * k[None, :]
+    d = np.stack([np.broadcast_to(r * np.cos(phi), (quadrature, quadrature)),
+                  np.broadcast_to(r * np.sin(phi), (quadrature, quadrature)),
+                  np.broadcast_to(np.sqrt(1.0 - r * r), (quadrature, quadrature))], -1).reshape(-1, 3)
+    out = np.empty(len(rho))
+    for i, x in enumerate(rho):
+        oc = np.array([x, 0.0, -radius])  # origin minus sphere centre (centre at (0, 0, R))
+        b = d @ oc
+        disc = b * b - (oc @ oc - radius * radius)
+        t = -b - np.sqrt(np.maximum(disc, 0.0))
+        hit = (disc > 0.0) & (t > 0.0)
+        w = np.where(hit, occlusion_weight(np.where(hit, t, np.inf), max_distance, "wendland"), 0.0)
+        out[i] = 1.0 - w.mean()
     return out

@@ -1,0 +1,36 @@
+/* Shared by the Hybrid Ambient Occlusion passes; mirrored in hao_addon/core/ao_pattern.py
+ * and hao_addon/core/bilateral.py, which the tests compare against. */
+#define HAO_GOLDEN_FRACTION 0.6180339887498949
+#define HAO_SELF_OFFSET 1.75
+
+/* Wendland C2 kernel, HAO paper equation 3: w(t, h) = (1 - t/h)^4 (4 t/h + 1) on [0, h]. */
+float wendland(float t, float h)
+{
+  float x = clamp(t / h, 0.0, 1.0);
+  float y = 1.0 - x;
+  return y * y * y * y * (4.0 * x + 1.0);
+}
+
+/* PCG3D hash (Jarzynski & Olano 2020). */
+uvec3 pcg3d(uvec3 v)
+{
+  v = v * 1664525u + 1013904223u;
+  v.x += v.y * v.z;
+  v.y += v.z * v.x;
+  v.z += v.x * v.y;
+  v ^= v >> 16u;
+  v.x += v.y * v.z;
+  v.y += v.z * v.x;
+  v.z += v.x * v.y;
+  return v;
+}
+
+/* Branchless orthonormal basis around n (Duff et al. 2017). */
+void tangent_frame(vec3 n, out vec3 t, out vec3 s)
+{
+  float sgn = n.z >= 0.0 ? 1.0 : -1.0;
+  float a = -1.0 / (sgn + n.z);
+  float b = n.x * n.y * a;
+  t = vec3(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+  s = vec3(b, sgn + n.y * n.y * a, -n.y);
+}

@@ -1,0 +1,102 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Hybrid Ambient Occlusion frame: voxelize -> G-buffer -> AO sampling -> bilateral upsample.
+One code path for the viewport overlay and the headless render (hao_addon/render_ao.py).
+
+Skips (counted in `stats`, shown by tests/test_hao_skip.py):
+- geometry upload and voxelization only when an object's key (geometry or transform), the
+  set of objects, the region of interest or the grid resolution changed;
+- G-buffer only when the view, the size or the geometry changed;
+- AO sampling only when the G-buffer, the grid or a sampling setting changed;
+- filtering only when the AO or a filter setting changed;
+- inside the AO pass, background pixels, objects with a baked AO map and points outside the
+  region of interest are not marched (`sampled_pixels` counts those that are).
+"""
+from __future__ import annotations
+
+from collections import Counter
+
+import gpu
+import numpy as np
+
+from ..core.plan import BakeInputError
+from ..core.view_scene import SceneObject, scene_bounds
+from ..core.view_settings import ViewAOSettings
+from ..core.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
+from . import util
+from .hao_gbuffer import GBufferPass
+from .hao_sampling import AOSamplingPass, BilateralPass
+from .hao_voxelize import VoxelPass
+
+
+class HaoRenderer(util.GPUPass):
+    def __init__(self) -> None:
+        super().__init__()
+        self.voxels = VoxelPass()
+        self.gbuffer = GBufferPass()
+        self.sampling = AOSamplingPass()
+        self.filter = BilateralPass()
+        self.stats: Counter = Counter()
+        self._keys: dict[str, object] = {}
+        self.spec: GridSpec | None = None
+
+    def _changed(self, name: str, key: object) -> bool:
+        if self._keys.get(name) == key:
+            return False
+        self._keys[name] = key
+        return True
+
+    def render(self, objects: list[SceneObject], view_proj: np.ndarray, width: int, height: int,
+               settings: ViewAOSettings, region: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """Run what changed since the last call. view_proj: (4, 4) world -> clip;
+        region: world box (lo, hi) of the region of interest, default the objects' bounds."""
+        settings = settings.validated()
+        if width < 1 or height < 1:
+            raise BakeInputError(f"image size must be positive, got {width}x{height}")
+        self.stats["frames"] += 1
+        geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
+        if self._changed("geometry", geometry_key):
+            pos = (np.concatenate([o.positions for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
+            nrm = (np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
+            flags = np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects]) \
+                if objects else np.zeros(0, np.float32)
+            solid = np.concatenate([np.full(len(o.positions), o.solid) for o in objects]) if objects else np.zeros(0, bool)
+            self.voxels.set_geometry(pos, dominant_axes(pos), solid)
+            self.gbuffer.set_geometry(pos, nrm, flags)
+            self.stats["upload"] += 1
+        bounds = region if region is not None else scene_bounds(objects)
+        if bounds is None:
+            raise BakeInputError("nothing to render: no visible mesh objects")
+        self.spec = grid_for_bounds(bounds[0], bounds[1], settings.grid)
+        grid_key = (geometry_key, self.spec)
+        if self._changed("grid", grid_key):
+            self.voxels.voxelize(self.spec)
+            self.stats["voxelize"] += 1
+        view_key = (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height)
+        if self._changed("view", view_key):
+            self.gbuffer.render(view_proj, width, height)
+            self.stats["gbuffer"] += 1
+        ao_key = (grid_key, view_key, settings.rays, settings.steps, settings.spread, settings.max_distance,
+                  settings.scale)
+        if self._changed("ao", ao_key):
+            self.sampling.run(self.gbuffer, self.voxels, settings)
+            self.stats["ao"] += 1
+        if self._changed("filter", (ao_key, settings.filter_size)):
+            self.filter.run(self.gbuffer, self.sampling.ao_low, settings)
+            self.stats["filter"] += 1
+
+    @property
+    def ao_texture(self) -> "gpu.types.GPUTexture":
+        return self.filter.ao
+
+    def read_ao(self) -> np.ndarray:
+        """(H, W) float32 accessibility, row 0 bottom; 1 on background."""
+        return self.filter.read()
+
+    def sampled_pixels(self) -> int:
+        """AO-map pixels the last AO pass marched (the rest were skipped)."""
+        return self.sampling.sampled_pixels()
+
+    def _release(self) -> None:
+        for p in (self.voxels, self.gbuffer, self.sampling, self.filter):
+            p.free()
+        self._keys.clear()

@@ -1,0 +1,151 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""AO sampling and joint bilateral upsampling passes of Hybrid Ambient Occlusion (compute)."""
+from __future__ import annotations
+
+import gpu
+import numpy as np
+
+from ..core.view_settings import ViewAOSettings
+from . import util
+from .shaders import cached_shader, glsl_source
+
+GROUP = 8
+
+
+def _ao_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.local_group_size(GROUP, GROUP, 1)
+    info.push_constant('VEC4', "grid_origin")
+    info.push_constant('IVEC4', "grid_dims")
+    info.push_constant('IVEC2', "full_size")
+    info.push_constant('INT', "scale")
+    info.push_constant('INT', "rays")
+    info.push_constant('INT', "steps")
+    info.push_constant('FLOAT', "spread")
+    info.push_constant('FLOAT', "max_distance")
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    info.image(2, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
+    info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
+    info.image(4, 'R32UI', 'UINT_2D', "sampled_count", qualifiers={'READ', 'WRITE'})
+    info.compute_source(glsl_source("hao_common.glsl", "hao_ao.comp"))
+    return info
+
+
+def _bilateral_info(axis: int, upsample: bool) -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.local_group_size(GROUP, GROUP, 1)
+    info.define("AXIS", str(axis))
+    if upsample:
+        info.define("UPSAMPLE", "1")
+    info.push_constant('IVEC2', "full_size")
+    info.push_constant('INT', "scale")
+    info.push_constant('INT', "filter_size")
+    info.push_constant('FLOAT', "max_distance")
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    info.image(2, 'R32F', 'FLOAT_2D', "ao_src", qualifiers={'READ'})
+    info.image(3, 'R32F', 'FLOAT_2D', "ao_dst", qualifiers={'WRITE'})
+    info.compute_source(glsl_source("hao_common.glsl", "hao_bilateral.comp"))
+    return info
+
+
+def ao_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("hao_ao",), _ao_info)
+
+
+def bilateral_shader(axis: int, upsample: bool) -> "gpu.types.GPUShader":
+    return cached_shader(("hao_bilateral", axis, upsample), lambda: _bilateral_info(axis, upsample))
+
+
+def _set_optional(shader, name: str, value, integer: bool = False) -> None:
+    """Push constants the compiler dropped (a variant not using them) raise on set."""
+    try:
+        (shader.uniform_int if integer else shader.uniform_float)(name, value)
+    except ValueError:
+        pass
+
+
+class AOSamplingPass(util.GPUPass):
+    """Owns the low-resolution AO map."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.ao_low = None
+        self.low_size = (0, 0)
+        self.counter = None
+
+    def run(self, gbuffer, voxels, settings: ViewAOSettings) -> None:
+        width, height = gbuffer.size
+        k = settings.scale
+        low = (-(-width // k), -(-height // k))
+        if self.low_size != low:
+            self.ao_low = gpu.types.GPUTexture(low, format='R32F')
+            self.low_size = low
+        if self.counter is None:
+            self.counter = gpu.types.GPUTexture((1, 1), format='R32UI')
+        self.counter.clear(format='UINT', value=(0,))
+        spec = voxels.spec
+        shader = ao_shader()
+        shader.bind()
+        shader.uniform_float("grid_origin", (*spec.origin, spec.voxel))
+        shader.uniform_int("grid_dims", (*spec.dims, 0))
+        shader.uniform_int("full_size", (width, height))
+        shader.uniform_int("scale", k)
+        shader.uniform_int("rays", settings.rays)
+        shader.uniform_int("steps", settings.steps)
+        shader.uniform_float("spread", settings.spread)
+        shader.uniform_float("max_distance", settings.max_distance)
+        shader.image("gbuf_position", gbuffer.position)
+        shader.image("gbuf_normal", gbuffer.normal)
+        shader.image("grid", voxels.grid)
+        shader.image("ao_low", self.ao_low)
+        shader.image("sampled_count", self.counter)
+        gpu.compute.dispatch(shader, -(-low[0] // GROUP), -(-low[1] // GROUP), 1)
+        gpu.shader.unbind()
+
+    def read(self) -> np.ndarray:
+        return util.texture_to_numpy(self.ao_low)
+
+    def sampled_pixels(self) -> int:
+        return int(util.texture_to_numpy(self.counter, np.uint32).ravel()[0])
+
+    def _release(self) -> None:
+        self.ao_low = self.counter = None
+        self.low_size = (0, 0)
+
+
+class BilateralPass(util.GPUPass):
+    """Owns the intermediate and the full-resolution AO."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.middle = self.ao = None
+        self.size = (0, 0)
+
+    def run(self, gbuffer, ao_low, settings: ViewAOSettings) -> None:
+        width, height = gbuffer.size
+        if self.size != (width, height):
+            self.middle = gpu.types.GPUTexture((width, height), format='R32F')
+            self.ao = gpu.types.GPUTexture((width, height), format='R32F')
+            self.size = (width, height)
+        for axis, src, dst in ((0, ao_low, self.middle), (1, self.middle, self.ao)):
+            shader = bilateral_shader(axis, axis == 0)
+            shader.bind()
+            shader.uniform_int("full_size", (width, height))
+            _set_optional(shader, "scale", settings.scale, integer=True)
+            shader.uniform_int("filter_size", settings.filter_size)
+            shader.uniform_float("max_distance", settings.max_distance)
+            shader.image("gbuf_position", gbuffer.position)
+            shader.image("gbuf_normal", gbuffer.normal)
+            shader.image("ao_src", src)
+            shader.image("ao_dst", dst)
+            gpu.compute.dispatch(shader, -(-width // GROUP), -(-height // GROUP), 1)
+        gpu.shader.unbind()
+
+    def read(self) -> np.ndarray:
+        return util.texture_to_numpy(self.ao)
+
+    def _release(self) -> None:
+        self.middle = self.ao = None
+        self.size = (0, 0)

@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Headless HAO render from a scene camera: the viewport overlay's passes (one HaoRenderer),
+read back as an image. Used by the Render AO operator and ``python -m hao_addon render-ao``."""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from .blender.view_scene import camera_view_projection, visible_scene_objects
+from .core.plan import BakeInputError
+from .core.view_settings import ViewAOSettings
+
+
+def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: int, height: int,
+                     settings: ViewAOSettings, region=None, skip_baked: bool = False,
+                     renderer=None) -> np.ndarray:
+    """(H, W, 4) float32 RGBA, row 0 at the bottom: accessibility in RGB (1 = open), alpha 1
+    on geometry and 0 on background (whose RGB is 1). `renderer`: a HaoRenderer to reuse
+    (its skips then apply across calls); by default a temporary one."""
+    from .gpu.context import ensure_gpu_context
+    from .gpu.hao_renderer import HaoRenderer
+
+    if camera is None or camera.type != 'CAMERA':
+        raise BakeInputError("no camera: pass --camera NAME or give the scene a camera")
+    settings = settings.validated()
+    ensure_gpu_context()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view_layer = bpy.context.view_layer
+    objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)
+    if not objects:
+        raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects")
+    view_proj = camera_view_projection(camera, depsgraph, width, height)
+    own = renderer is None
+    renderer = renderer or HaoRenderer()
+    try:
+        renderer.render(objects, view_proj, width, height, settings, region)
+        ao = renderer.read_ao()
+        coverage = renderer.gbuffer.read()[0][..., 3] > 0.0
+    finally:
+        if own:
+            renderer.free()
+    rgba = np.empty((height, width, 4), np.float32)
+    rgba[..., :3] = ao[..., None]
+    rgba[..., 3] = coverage
+    return rgba

@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Viewport HAO passes against their CPU references and the ray-traced ground truth.
+
+Tolerances. With N rays per pixel and binary visibility, one pixel's estimate has a standard
+error of at most sigma_N = 0.5 / sqrt(N) (at A = 1/2); the pattern is stratified, so the
+real error is smaller. Voxels add a systematic term: an occluder is moved by up to one voxel
+diagonal (sqrt(3) h) and the march starts 1.75 h off the surface, which changes hit
+distances by about 2 h; with the Wendland kernel (slope at most 1.6 / d_max... times the
+occluded fraction) this is a few hundredths at h = d_max / 16. The bounds below are
+RMSE <= sigma_N / 2 + VOXEL_TERM with VOXEL_TERM = 2 h / d_max, and |bias| <= VOXEL_TERM.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hao_addon.core import camera_math as cm
+from hao_addon.core import scenes
+from hao_addon.core.ao_pattern import march_reference
+from hao_addon.core.bilateral import joint_bilateral_upsample
+from hao_addon.core.geometry import TriangleSoup
+from hao_addon.core.reference import reference_accessibility
+from hao_addon.core.view_scene import object_from_soup
+from hao_addon.core.view_settings import ViewAOSettings
+from hao_addon.core.voxel_grid import dominant_axes, grid_for_bounds, solid_reference, voxelize_reference
+
+R = 0.5
+
+
+def sphere_plane_scene():
+    sphere = scenes.uv_sphere(R, (0.0, 0.0, R), 48, 24, name="sphere")
+    plane = scenes.grid_plane(6.0, 12, name="plane")
+    return [object_from_soup(plane, "plane"), object_from_soup(sphere, "sphere")], [plane, sphere]
+
+
+def view(eye, target=(0.0, 0.0, 0.3), width=160, height=120, fov=0.9):
+    return cm.perspective(fov, width / height, 0.05, 100.0) @ cm.look_at(eye, target), width, height
+
+
+@pytest.fixture
+def renderer(gpu_context):
+    from hao_addon.gpu.hao_renderer import HaoRenderer
+    r = HaoRenderer()
+    yield r
+    r.free()
+
+
+def low_res_samples(renderer, settings):
+    """World positions/normals of the G-buffer pixels the AO pass sampled, the AO there, and
+    the mask of sampled (covered) AO-map pixels."""
+    pos, nrm, _ = renderer.gbuffer.read()
+    low = renderer.sampling.read()
+    h, w = pos.shape[:2]
+    k = settings.scale
+    ly, lx = np.mgrid[0:low.shape[0], 0:low.shape[1]]
+    py, px = np.minimum(ly * k + k // 2, h - 1), np.minimum(lx * k + k // 2, w - 1)
+    valid = pos[py, px, 3] >= 1.0
+    return pos[py, px, :3][valid].astype(np.float64), nrm[py, px, :3][valid].astype(np.float64), low[valid]
+
+
+def test_voxel_grid_matches_cpu_voxelization(renderer):
+    """Surface (dominant axis) and solid (parity) voxels equal the CPU rule except where float
+    rounding decides: column centres within 1e-4 (barycentric) of an edge or depths within
+    1e-4 voxel of a boundary. Those may differ; every other voxel must match."""
+    torus = scenes.torus(0.6, 0.2, (0.0, 0.0, 0.2), 40, 20)
+    tilted = TriangleSoup(torus.positions @ np.array([[0.8, 0.0, 0.6], [0.0, 1.0, 0.0], [-0.6, 0.0, 0.8]]).T,
+                          torus.uvs)
+    plane = scenes.grid_plane(2.0, 8)
+    objs = [object_from_soup(tilted, "t"), object_from_soup(plane, "p")]
+    assert objs[0].solid and not objs[1].solid
+    pos = np.concatenate([o.positions for o in objs]).astype(np.float64)
+    for resolution in (64, 128):
+        spec = grid_for_bounds(pos.reshape(-1, 3).min(0), pos.reshape(-1, 3).max(0), resolution)
+        renderer.voxels.set_geometry(pos.astype(np.float32), dominant_axes(pos),
+                                     np.repeat([True, False], [len(objs[0].positions), len(objs[1].positions)]))
+        renderer.voxels.voxelize(spec)
+        gpu_grid = renderer.voxels.read_grid()
+        surface, amb_s = voxelize_reference(pos, spec)
+        solid, amb_v = solid_reference(objs[0].positions.astype(np.float64), spec)
+        expected = surface | solid
+        differ = gpu_grid != expected
+        ambiguous = amb_s | amb_v
+        assert not (differ & ~ambiguous).any(), f"{(differ & ~ambiguous).sum()} unambiguous voxels differ"
+        assert differ.sum() <= 0.05 * expected.sum()
+        assert solid.sum() > surface.sum()  # the torus is filled, not a shell
+
+
+def test_ao_pass_equals_numpy_march(renderer):
+    objs, _ = sphere_plane_scene()
+    settings = ViewAOSettings(rays=16, steps=8, max_distance=1.0, grid=96)
+    vp, w, h = view((2.0, -2.5, 2.0))
+    renderer.render(objs, vp, w, h, settings)
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    spec = renderer.spec
+    ref = march_reference(renderer.voxels.read_grid(), np.array(spec.origin), spec.voxel, pts, nrm,
+                          settings.rays, settings.steps, settings.spread, settings.max_distance)
+    diff = np.abs(ao - ref)
+    # float32 on the GPU, float64 here: a sample on a voxel boundary may land on either side.
+    assert np.mean(diff > 1e-4) < 0.01 and diff.mean() < 1e-3
+    assert ao.min() < 0.6  # the contact region is dark: the pass did see the sphere
+
+
+def test_lone_plane_is_open_at_any_tilt(renderer):
+    """Self-intersection avoidance: the 1.75-voxel start offset exceeds the sqrt(3)-voxel reach
+    of a plane's own voxels, so a lone plane gets exactly 1 whatever its orientation."""
+    settings = ViewAOSettings(rays=32, steps=16, max_distance=0.5, grid=128)
+    for angle in (0.0, 0.3, 0.785, 1.1):
+        c, s = np.cos(angle), np.sin(angle)
+        rot = np.array([[1, 0, 0], [0, c, -s], [0, s, c]]) @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        plane = scenes.grid_plane(3.0, 6)
+        tilted = TriangleSoup(plane.positions @ rot.T, plane.uvs)
+        normal = rot @ np.array([0.0, 0.0, 1.0])
+        vp, w, h = view(normal * 3.0 + np.array([0.3, 0.2, 0.1]), target=(0.0, 0.0, 0.0))
+        renderer.render([object_from_soup(tilted, f"plane{angle}")], vp, w, h, settings)
+        _, _, ao = low_res_samples(renderer, settings)
+        assert len(ao) > 1000 and ao.min() == 1.0, angle
+
+
+def test_bilateral_filter_matches_numpy_reference(renderer):
+    objs, _ = sphere_plane_scene()
+    settings = ViewAOSettings(rays=8, steps=8, max_distance=1.0, grid=64, filter_size=6, scale=2)
+    vp, w, h = view((2.0, -2.5, 2.0), width=96, height=72)
+    renderer.render(objs, vp, w, h, settings)
+    pos, nrm, _ = renderer.gbuffer.read()
+    low = renderer.sampling.read()
+    expected = joint_bilateral_upsample(low, pos[..., :3], nrm[..., :3], pos[..., 3] >= 1.0, settings.scale,
+                                        settings.filter_size, settings.max_distance)
+    got = renderer.read_ao()
+    assert np.abs(got - expected).max() < 1e-4
+    assert np.abs(got - np.repeat(np.repeat(low, 2, 0), 2, 1)[:72, :96]).max() > 0.01  # it did filter
+
+
+def ground_truth_rmse(renderer, settings, soups, rays=512):
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    tris = np.concatenate([s.positions for s in soups])
+    gt = reference_accessibility(pts, nrm, tris, rays=rays, max_distance=settings.max_distance,
+                                 falloff="wendland", seed=5)
+    e = ao - gt
+    return float(np.sqrt((e * e).mean())), float(e.mean()), len(e)
+
+
+@pytest.mark.parametrize("rays", [32, 128])
+def test_ao_against_ray_traced_ground_truth(renderer, rays):
+    objs, soups = sphere_plane_scene()
+    settings = ViewAOSettings(rays=rays, steps=16, max_distance=1.0, grid=128)
+    vp, w, h = view((2.0, -2.5, 2.0))
+    renderer.render(objs, vp, w, h, settings)
+    rmse, bias, n = ground_truth_rmse(renderer, settings, soups)
+    voxel_term = 2.0 * renderer.spec.voxel / settings.max_distance
+    reference_noise = 0.5 / np.sqrt(512)
+    assert n > 2000
+    assert rmse <= 0.5 / np.sqrt(rays) / 2 + voxel_term + reference_noise, (rmse, bias)
+    assert abs(bias) <= voxel_term, (rmse, bias)
+
+
+def test_sphere_on_plane_against_exact_geometry(renderer):
+    """Plane points around a resting sphere against the exact-geometry value with the same
+    Wendland kernel (core/scenes.py; it reproduces 1 - (R/D)^3 for unlimited reach)."""
+    objs, _ = sphere_plane_scene()
+    settings = ViewAOSettings(rays=128, steps=32, max_distance=1.5, grid=192, filter_size=0)
+    vp, w, h = view((0.01, -0.01, 4.0), target=(0.0, 0.0, 0.0), width=192, height=192, fov=1.2)
+    renderer.render(objs, vp, w, h, settings)
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    on_plane = (np.abs(pts[:, 2]) < 1e-3) & (np.hypot(pts[:, 0], pts[:, 1]) > 0.15)
+    rho = np.hypot(pts[on_plane, 0], pts[on_plane, 1])
+    exact = scenes.sphere_on_plane_kernel_accessibility(rho, R, settings.max_distance, quadrature=96)
+    e = ao[on_plane] - exact
+    voxel_term = 2.0 * renderer.spec.voxel / settings.max_distance
+    assert on_plane.sum() > 1500
+    assert np.sqrt((e * e).mean()) <= 0.5 / np.sqrt(settings.rays) / 2 + voxel_term
+    assert abs(e.mean()) <= voxel_term
+    assert exact.min() < 0.85  # the comparison includes the shaded ring around the sphere
+
+
+def test_view_independence_occluder_behind_the_camera(renderer):
+    """A wall behind the camera (off screen) darkens the floor in front of it exactly as when
+    the wall is in view: same surface points, same AO within 0.03 (filtered images)."""
+    floor = scenes.grid_plane(4.0, 8, name="floor")
+    wall = scenes.wall(4.0, 1.5, 0.0)  # x = 0, facing -x; the floor strip x in [-0.8, 0] sees it
+    objs = [object_from_soup(floor, "floor"), object_from_soup(wall, "wall")]
+    # The wall is a sheet (voxelized as a one-voxel shell): steps finer than a voxel hit it.
+    settings = ViewAOSettings(rays=64, steps=64, max_distance=1.5, grid=128)
+    target = (-0.4, 0.0, 0.0)
+    views = {"wall on screen": view((-2.5, 0.0, 1.6), target=target),
+             "wall behind camera": view((-0.05, 0.0, 1.2), target=(-0.8, 0.0, 0.0))}
+    results = {}
+    for name, (vp, w, h) in views.items():
+        renderer.render(objs, vp, w, h, settings)
+        pos, _, _ = renderer.gbuffer.read()
+        results[name] = (vp, pos, renderer.read_ao())
+    vp_b, pos_b, ao_b = results["wall behind camera"]
+    vp_a, pos_a, ao_a = results["wall on screen"]
+    # Points the second camera sees on the floor near the wall, looked up in the first image.
+    sel = (pos_b[..., 3] >= 1.0) & (np.abs(pos_b[..., 2]) < 1e-3) & (pos_b[..., 0] > -0.9) & (pos_b[..., 0] < -0.05)
+    pts = pos_b[sel][:, :3]
+    clip = np.c_[pts, np.ones(len(pts))] @ vp_a.T
+    ndc = clip[:, :2] / clip[:, 3:4]
+    h, w = ao_a.shape
+    px = np.clip(((ndc[:, 0] * 0.5 + 0.5) * w).astype(int), 0, w - 1)
+    py = np.clip(((ndc[:, 1] * 0.5 + 0.5) * h).astype(int), 0, h - 1)
+    same = np.linalg.norm(pos_a[py, px, :3] - pts, axis=1) < 0.05
+    assert same.sum() > 300
+    diff = ao_a[py, px][same] - ao_b[sel][same]
+    assert ao_b[sel].min() < 0.9  # the off-screen wall does darken the floor
+    assert np.sqrt((diff * diff).mean()) <= 0.03, np.sqrt((diff * diff).mean())
