@@ -36,6 +36,13 @@ def test_every_shader_variant_compiles(gpu_context):
                     bake_scatter.splat_shader(uniform, layered, wendland, footprint)
         bake_gather.gather_shader(uniform)
         bake_gather.texel_list_shader(fill=uniform)
+    from hao_addon.gpu import hao_composite, hao_gbuffer, hao_sampling, hao_voxelize
+    from hao_addon.gpu.shaders import cached_shader
+    hao_addon_shaders = [hao_gbuffer.gbuffer_shader(), hao_sampling.ao_shader(), hao_voxelize.voxelize_shader(True),
+                         hao_voxelize.voxelize_shader(False)]
+    for axis in (0, 1):
+        hao_addon_shaders.append(hao_sampling.bilateral_shader(axis, axis == 0))
+    cached_shader(("hao_composite",), hao_composite._composite_info)
     # Every file in gpu_shaders/ is used by some pass (no dead shader text ships).
     sources = "".join(p.read_text() for p in (shaders.SHADER_DIR.parent / "hao_addon").rglob("*.py"))
     for path in shaders.SHADER_DIR.iterdir():
@@ -44,13 +51,20 @@ def test_every_shader_variant_compiles(gpu_context):
 
 def test_registration_needs_no_gpu_and_is_symmetric(addon):
     import bpy
-    from hao_ext.operators import cli_command
+    from hao_ext.operators import cli_command, viewport_overlay
     from hao_ext.operators.properties import HAO_PG_bake_settings
-    names = ("OBJECT_OT_hao_bake_ao", "VIEW3D_PT_hao_bake")
-    assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
+    names = ("OBJECT_OT_hao_bake_ao", "VIEW3D_PT_hao_bake", "RENDER_OT_hao_render_ao", "VIEW3D_PT_hao_view")
+    handler_lists = (bpy.app.handlers.depsgraph_update_post, bpy.app.handlers.frame_change_post,
+                     bpy.app.handlers.load_post)
+    counts = [len(h) for h in handler_lists]
+    assert hasattr(bpy.types.Scene, "hao_bake") and hasattr(bpy.types.Scene, "hao_view")
+    assert all(hasattr(bpy.types, n) for n in names)
     addon.unregister()
-    assert not hasattr(bpy.types.Scene, "hao_bake") and not any(hasattr(bpy.types, n) for n in names)
+    assert not hasattr(bpy.types.Scene, "hao_bake") and not hasattr(bpy.types.Scene, "hao_view")
+    assert not any(hasattr(bpy.types, n) for n in names)
     assert not HAO_PG_bake_settings.is_registered
-    assert cli_command._handle is None
+    assert cli_command._handle is None and viewport_overlay._draw_handle is None
+    assert [len(h) for h in handler_lists] == [c - 1 for c in counts]
     addon.register()
     assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
+    assert [len(h) for h in handler_lists] == counts
