@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Markdown tables from bench/results/bake_bench.json (pasted into the README).
+"""Markdown tables from bench/results/bake_bench.json or hao_bench.json (pasted into the README).
 
-    .venv/bin/python bench/report.py [bench/results/bake_bench.json]
+    .venv/bin/python bench/report.py [bench/results/bake_bench.json | bench/results/hao_bench.json]
 
 Equal-error speed-up: for each Cycles run, the time HAO needs for the same interior RMSE,
 interpolated linearly in log(time)-log(RMSE) between the two HAO runs around it.
@@ -24,9 +24,41 @@ def time_at_rmse(runs: list[dict], rmse: float) -> float | None:
     return float(np.exp(np.interp(np.log(rmse), e[order], t[order])))
 
 
+def hao_tables(res: dict) -> str:
+    st = res["settings"]
+    lines = [f"Frame {st['width']}x{st['height']}, AO map 1/{st['scale']}, {st['rays']} rays, {st['steps']} steps, "
+             f"{st['grid']}^3 grid, filter {st['filter_size']}, d_max {st['max_distance']} (median ms):\n",
+             "| scene | triangles | voxelize | G-buffer | AO | filter | composite | frame | Workbench (AA off) | frame / Workbench |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for name, sc in res["scenes"].items():
+        p = sc["passes_ms"]
+        lines.append(f"| {name} | {sc['triangles']:,} | {p['voxelize']:.1f} | {p['gbuffer']:.1f} | {p['ao']:.1f} | "
+                     f"{p['filter']:.1f} | {p['composite']:.1f} | {p['frame']:.1f} | {sc['workbench_ms']:.1f} | "
+                     f"{sc['frame_over_workbench']:.2f}x |")
+    lines.append(f"\nAO passes (sampling + filter), 1M-triangle torus over bunny: "
+                 f"{res['ao_passes_1M_over_bunny']:.2f}x.\n")
+    for name, err in res["error"].items():
+        lines.append(f"Error, {name} ({err['points']} visible pixels, reference {err['reference_rays']} rays):\n")
+        lines.append("| variant | frame ms | AO passes ms | RMSE |")
+        lines.append("|---|---:|---:|---:|")
+        for r in err["runs"]:
+            lines.append(f"| {r['label']} | {r['frame_ms']:.1f} | {r['ao_passes_ms']:.1f} | {r['rmse']:.4f} |")
+        lines.append("")
+    for param, rows in res["sweeps"].items():
+        lines.append(f"Sweep of {param} (bunny): " + ", ".join(f"{r['value']}: {r['frame']:.0f} ms" for r in rows) + "\n")
+    lines.append("Cost against triangle count (torus on a floor): " + ", ".join(
+        f"{r['triangles']:,}: vox {r['voxelize']:.0f} / G-buf {r['gbuffer']:.0f} / AO+filter {r['ao_passes']:.0f} ms"
+        for r in res["triangles"]) + "\n")
+    lines.append(f"Machine: {res['machine']['platform']}; Blender {res['machine']['blender']}; {res['machine']['gpu']}.")
+    return "\n".join(lines)
+
+
 def main() -> int:
     path = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parent / "results" / "bake_bench.json")
     res = json.loads(path.read_text())
+    if "scenes" in res:
+        print(hao_tables(res))
+        return 0
     lines = []
     for name, m in res["meshes"].items():
         lines.append(f"**{name}** ({m['triangles']:,} triangles, {m['size']}x{m['size']}; xatlas "

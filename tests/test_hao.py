@@ -150,6 +150,7 @@ def test_ao_against_ray_traced_ground_truth(renderer, rays):
     reference_noise = 0.5 / np.sqrt(512)
     assert n > 2000
     assert rmse <= 0.5 / np.sqrt(rays) / 2 + voxel_term + reference_noise, (rmse, bias)
+    assert rmse <= 0.05  # the accuracy target (measured 0.021 at both ray counts)
     assert abs(bias) <= voxel_term, (rmse, bias)
 
 

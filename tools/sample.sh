@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# Set up (if needed) and run the main job on the bundled sample: bake the AO map of Spot
-# (samples/spot.obj) to out/spot_ao.png (16-bit) and out/spot_ao.exr (32-bit float).
+# Set up (if needed) and run the main job on the bundled sample (Spot, samples/spot.obj):
+# bake its AO map to out/spot_ao.png (16-bit) and out/spot_ao.exr (32-bit float), then
+# render viewport AO (HAO) of Spot on a floor from a camera to out/spot_viewport_ao.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 mkdir -p out
 .venv/bin/python -m hao_addon bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.png
 .venv/bin/python -m hao_addon bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.exr
+.venv/bin/python samples/make_scene.py out/spot_scene.blend
+.venv/bin/python -m hao_addon render-ao out/spot_scene.blend --camera Camera --width 800 --height 600 \
+    --max-distance 0.5 --out out/spot_viewport_ao.png
