@@ -58,6 +58,17 @@ def test_each_pass_runs_only_when_its_inputs_change(renderer):
     assert runs() == dict(upload=2, voxelize=2, gbuffer=3, ao=4, filter=5)
     renderer.render([objs[0], moved], vp2, w, h, settings.with_(filter_size=4, rays=16, grid=96))  # grid only
     assert runs() == dict(upload=2, voxelize=3, gbuffer=3, ao=5, filter=6)
+    # With a region around the sphere, an object changing outside it is not re-voxelized.
+    region = (np.array([-0.7, -0.7, -0.2]), np.array([0.7, 0.7, 1.3]))
+    far = object_from_soup(scenes.uv_sphere(0.3, (2.5, 0.0, 0.3), 16, 8, name="far"), "far-a")
+    s2 = settings.with_(filter_size=4, rays=16, grid=96)
+    renderer.render([objs[0], moved, far], vp2, w, h, s2, region)
+    base = runs()
+    far.key = "far-b"
+    far.positions = far.positions + np.float32(0.05)
+    renderer.render([objs[0], moved, far], vp2, w, h, s2, region)
+    assert runs()["upload"] == base["upload"] + 1 and runs()["gbuffer"] == base["gbuffer"] + 1
+    assert runs()["voxelize"] == base["voxelize"]
 
 
 def test_background_baked_and_out_of_region_pixels_are_not_sampled(renderer):

@@ -3,8 +3,9 @@
 One code path for the viewport overlay and the headless render (hao_addon/render_ao.py).
 
 Skips (counted in `stats`, shown by tests/test_hao_skip.py):
-- geometry upload and voxelization only when an object's key (geometry or transform), the
-  set of objects, the region of interest or the grid resolution changed;
+- geometry upload only when an object's key (geometry or transform) or the set of objects
+  changed; voxelization only when that happened to an object reaching into the region of
+  interest, or the region or the grid resolution changed;
 - G-buffer only when the view, the size or the geometry changed;
 - AO sampling only when the G-buffer, the grid or a sampling setting changed;
 - filtering only when the AO or a filter setting changed;
@@ -26,6 +27,14 @@ from . import util
 from .hao_gbuffer import GBufferPass
 from .hao_sampling import AOSamplingPass, BilateralPass
 from .hao_voxelize import VoxelPass
+
+
+def _box_overlaps(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether the bounding box of (F, 3, 3) triangles overlaps the box [lo, hi]."""
+    if len(positions) == 0:
+        return False
+    flat = positions.reshape(-1, 3)
+    return bool((flat.min(0) <= hi).all() and (flat.max(0) >= lo).all())
 
 
 class HaoRenderer(util.GPUPass):
@@ -67,7 +76,11 @@ class HaoRenderer(util.GPUPass):
         if bounds is None:
             raise BakeInputError("nothing to render: no visible mesh objects")
         self.spec = grid_for_bounds(bounds[0], bounds[1], settings.grid)
-        grid_key = (geometry_key, self.spec)
+        # Only objects reaching into the region can change the grid: one moving outside a
+        # user region re-renders the G-buffer but is not re-voxelized.
+        lo, hi = np.asarray(self.spec.origin), np.asarray(self.spec.origin) + np.asarray(self.spec.dims) * self.spec.voxel
+        inside = tuple(k for o, k in zip(objects, geometry_key) if _box_overlaps(o.positions, lo, hi))
+        grid_key = (inside, self.spec)
         if self._changed("grid", grid_key):
             self.voxels.voxelize(self.spec)
             self.stats["voxelize"] += 1
