@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Render AO: the viewport HAO passes from the scene camera into an image datablock (and
 optionally a file), at the scene's render resolution. Same code path as the overlay."""
-from __future__ import annotations
 
 import bpy
 import numpy as np

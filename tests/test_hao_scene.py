@@ -13,7 +13,6 @@ import pytest
 from conftest import ROOT
 from hao_addon.core import camera_math as cm
 from hao_addon.core import scenes
-from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.view_scene import object_from_soup
 from hao_addon.core.view_settings import ViewAOSettings
 

@@ -72,16 +72,40 @@ def dominant_axes(positions: np.ndarray) -> np.ndarray:
     return np.argmax(np.abs(n), axis=1)
 
 
-def _edge_distance(uu, vv, w0, w1, w2, ar) -> np.ndarray:
-    """Smallest distance (voxels) from the column centre to the lines of the three edges."""
-    lengths = [np.hypot(uu[:, (k + 2) % 3] - uu[:, (k + 1) % 3], vv[:, (k + 2) % 3] - vv[:, (k + 1) % 3])
-               for k in range(3)]
-    dists = [np.abs(w * ar) / np.maximum(length, 1e-30) for w, length in zip((w0, w1, w2), lengths)]
-    return np.minimum(np.minimum(dists[0], dists[1]), dists[2])
+def _column_samples(u: np.ndarray, v: np.ndarray, d: np.ndarray, eps: float):
+    """Rasterize projected triangles at voxel-column centres, as the GPU does.
+
+    u, v, d: (F, 3) corner coordinates in the projection plane and along the projection axis
+    (voxel units). Yields, for each batch of (triangle, column) candidates in the triangles'
+    bounding boxes: column indices (ci, cj), the interpolated depth, `inside` (strictly inside
+    the triangle) and `near_edge` (within eps voxels of an edge line: the fill rule decides)."""
+    area = (u[:, 1] - u[:, 0]) * (v[:, 2] - v[:, 0]) - (v[:, 1] - v[:, 0]) * (u[:, 2] - u[:, 0])
+    keep = np.abs(area) > 1e-12  # edge-on in this projection: no column centre is covered
+    u, v, d, area = u[keep], v[keep], d[keep], area[keep]
+    i0 = np.floor(u.min(1) - 0.5).astype(int)
+    j0 = np.floor(v.min(1) - 0.5).astype(int)
+    wi = np.ceil(u.max(1) - 0.5).astype(int) - i0 + 1
+    wj = np.ceil(v.max(1) - 0.5).astype(int) - j0 + 1
+    lengths = [np.hypot(u[:, (k + 2) % 3] - u[:, (k + 1) % 3], v[:, (k + 2) % 3] - v[:, (k + 1) % 3]) for k in range(3)]
+    for di in range(int(wi.max(initial=0))):
+        for dj in range(int(wj.max(initial=0))):
+            sel = (di < wi) & (dj < wj)
+            if not sel.any():
+                continue
+            ci, cj = i0[sel] + di, j0[sel] + dj
+            pu, pv = ci + 0.5, cj + 0.5
+            uu, vv, dd, ar = u[sel], v[sel], d[sel], area[sel]
+            # Barycentric weights from edge functions (the sign of the area folded in).
+            w = [((uu[:, 1] - pu) * (vv[:, 2] - pv) - (vv[:, 1] - pv) * (uu[:, 2] - pu)) / ar,
+                 ((uu[:, 2] - pu) * (vv[:, 0] - pv) - (vv[:, 2] - pv) * (uu[:, 0] - pu)) / ar]
+            w.append(1.0 - w[0] - w[1])
+            depth = w[0] * dd[:, 0] + w[1] * dd[:, 1] + w[2] * dd[:, 2]
+            edge_dist = np.min([np.abs(w[k] * ar) / np.maximum(lengths[k][sel], 1e-30) for k in range(3)], axis=0)
+            yield ci, cj, depth, np.min(w, axis=0) > 0.0, edge_dist < eps
 
 
 def voxelize_reference(positions: np.ndarray, spec: GridSpec, eps: float = 2e-3) -> tuple[np.ndarray, np.ndarray]:
-    """CPU voxelization by the rule above.
+    """CPU voxelization by the surface rule above.
 
     positions: (F, 3, 3) world triangles. Returns (occupied, ambiguous), both (nz, ny, nx)
     bool: `ambiguous` marks voxels whose state depends on float rounding, where the GPU may
@@ -92,45 +116,20 @@ def voxelize_reference(positions: np.ndarray, spec: GridSpec, eps: float = 2e-3)
     nx, ny, nz = spec.dims
     occ = np.zeros((nz, ny, nx), bool)
     amb = np.zeros((nz, ny, nx), bool)
+    up = np.array([0, 0, 1])
     for a in range(3):
-        su, sv, sa = SWIZZLE[a]
+        swizzle = SWIZZLE[a]
         t = g[axes == a]
-        if len(t) == 0:
-            continue
-        u, v, d = t[:, :, su], t[:, :, sv], t[:, :, sa]
-        area = (u[:, 1] - u[:, 0]) * (v[:, 2] - v[:, 0]) - (v[:, 1] - v[:, 0]) * (u[:, 2] - u[:, 0])
-        keep = np.abs(area) > 1e-12
-        u, v, d, area = u[keep], v[keep], d[keep], area[keep]
-        i0 = np.floor(u.min(1) - 0.5).astype(int)
-        j0 = np.floor(v.min(1) - 0.5).astype(int)
-        wi = np.ceil(u.max(1) - 0.5).astype(int) - i0 + 1
-        wj = np.ceil(v.max(1) - 0.5).astype(int) - j0 + 1
-        for di in range(int(wi.max(initial=0))):
-            for dj in range(int(wj.max(initial=0))):
-                sel = (di < wi) & (dj < wj)
-                if not sel.any():
-                    continue
-                ci = i0[sel] + di
-                cj = j0[sel] + dj
-                pu, pv = ci + 0.5, cj + 0.5
-                uu, vv, dd, ar = u[sel], v[sel], d[sel], area[sel]
-                # Barycentric weights from edge functions (sign of the area folded in).
-                w0 = ((uu[:, 1] - pu) * (vv[:, 2] - pv) - (vv[:, 1] - pv) * (uu[:, 2] - pu)) / ar
-                w1 = ((uu[:, 2] - pu) * (vv[:, 0] - pv) - (vv[:, 2] - pv) * (uu[:, 0] - pu)) / ar
-                w2 = 1.0 - w0 - w1
-                wmin = np.minimum(np.minimum(w0, w1), w2)
-                depth = w0 * dd[:, 0] + w1 * dd[:, 1] + w2 * dd[:, 2]
-                ck = np.floor(depth).astype(int)
-                frac = depth - ck
-                near_edge = _edge_distance(uu, vv, w0, w1, w2, ar) < eps
-                inside = wmin > 0.0
-                near_depth = (inside | near_edge) & ((frac < eps) | (frac > 1.0 - eps))
-                column = np.stack([ci, cj, ck], 1)
-                up = np.array([0, 0, 1])
-                _mark(occ, column[inside], (su, sv, sa))
-                _mark(amb, column[near_edge], (su, sv, sa))
-                for shift in (-up, 0 * up, up):
-                    _mark(amb, column[near_depth] + shift, (su, sv, sa))
+        for ci, cj, depth, inside, near_edge in _column_samples(t[:, :, swizzle[0]], t[:, :, swizzle[1]],
+                                                                t[:, :, swizzle[2]], eps):
+            ck = np.floor(depth).astype(int)
+            frac = depth - ck
+            near_depth = (inside | near_edge) & ((frac < eps) | (frac > 1.0 - eps))
+            column = np.stack([ci, cj, ck], 1)
+            _mark(occ, column[inside], swizzle)
+            _mark(amb, column[near_edge], swizzle)
+            for shift in (-up, 0 * up, up):
+                _mark(amb, column[near_depth] + shift, swizzle)
     return occ, amb
 
 
@@ -146,6 +145,7 @@ def _mark(target: np.ndarray, uva: np.ndarray, swizzle: tuple[int, int, int]) ->
     xyz = xyz[ok]
     target[xyz[:, 2], xyz[:, 1], xyz[:, 0]] = True
 
+
 def solid_reference(positions: np.ndarray, spec: GridSpec, eps: float = 2e-3) -> tuple[np.ndarray, np.ndarray]:
     """CPU solid voxelization by the parity rule above: (inside, ambiguous), (nz, ny, nx)
     bool. Ambiguous: columns whose centre is within eps voxels of a projected edge (the whole
@@ -154,37 +154,18 @@ def solid_reference(positions: np.ndarray, spec: GridSpec, eps: float = 2e-3) ->
     nx, ny, nz = spec.dims
     flips = np.zeros((nz + 1, ny, nx), np.int32)  # difference array along z
     amb = np.zeros((nz, ny, nx), bool)
-    u, v, d = g[:, :, 0], g[:, :, 1], g[:, :, 2]
-    area = (u[:, 1] - u[:, 0]) * (v[:, 2] - v[:, 0]) - (v[:, 1] - v[:, 0]) * (u[:, 2] - u[:, 0])
-    keep = np.abs(area) > 1e-12
-    u, v, d, area = u[keep], v[keep], d[keep], area[keep]
-    i0 = np.floor(u.min(1) - 0.5).astype(int)
-    j0 = np.floor(v.min(1) - 0.5).astype(int)
-    wi = np.ceil(u.max(1) - 0.5).astype(int) - i0 + 1
-    wj = np.ceil(v.max(1) - 0.5).astype(int) - j0 + 1
-    for di in range(int(wi.max(initial=0))):
-        for dj in range(int(wj.max(initial=0))):
-            sel = (di < wi) & (dj < wj)
-            ci, cj = i0[sel] + di, j0[sel] + dj
-            ok = (ci >= 0) & (ci < nx) & (cj >= 0) & (cj < ny)
-            pu, pv = ci + 0.5, cj + 0.5
-            uu, vv, dd, ar = u[sel], v[sel], d[sel], area[sel]
-            w0 = ((uu[:, 1] - pu) * (vv[:, 2] - pv) - (vv[:, 1] - pv) * (uu[:, 2] - pu)) / ar
-            w1 = ((uu[:, 2] - pu) * (vv[:, 0] - pv) - (vv[:, 2] - pv) * (uu[:, 0] - pu)) / ar
-            w2 = 1.0 - w0 - w1
-            wmin = np.minimum(np.minimum(w0, w1), w2)
-            depth = w0 * dd[:, 0] + w1 * dd[:, 1] + w2 * dd[:, 2]
-            count = np.clip(np.ceil(depth - 0.5), 0, nz).astype(int)  # voxels k < depth - 1/2
-            inside = ok & (wmin > 0.0)
-            np.add.at(flips, (np.zeros(inside.sum(), int), cj[inside], ci[inside]), 1)
-            np.add.at(flips, (count[inside], cj[inside], ci[inside]), -1)
-            edge = ok & (_edge_distance(uu, vv, w0, w1, w2, ar) < eps)
-            amb[:, cj[edge], ci[edge]] = True
-            frac = depth - 0.5 - np.floor(depth - 0.5)
-            near = ok & (inside | edge) & ((frac < eps) | (frac > 1.0 - eps))
-            for dk in (-1, 0):
-                k = np.clip(count[near] + dk, 0, nz - 1)
-                amb[k, cj[near], ci[near]] = True
+    for ci, cj, depth, inside, edge in _column_samples(g[:, :, 0], g[:, :, 1], g[:, :, 2], eps):
+        ok = (ci >= 0) & (ci < nx) & (cj >= 0) & (cj < ny)
+        count = np.clip(np.ceil(depth - 0.5), 0, nz).astype(int)  # voxels k < depth - 1/2
+        flip = ok & inside
+        np.add.at(flips, (np.zeros(flip.sum(), int), cj[flip], ci[flip]), 1)
+        np.add.at(flips, (count[flip], cj[flip], ci[flip]), -1)
+        amb[:, cj[ok & edge], ci[ok & edge]] = True
+        frac = depth - 0.5 - np.floor(depth - 0.5)
+        near = ok & (inside | edge) & ((frac < eps) | (frac > 1.0 - eps))
+        for dk in (-1, 0):
+            k = np.clip(count[near] + dk, 0, nz - 1)
+            amb[k, cj[near], ci[near]] = True
     inside_count = np.cumsum(flips, axis=0)[:nz]
     return (inside_count % 2) == 1, amb
 
