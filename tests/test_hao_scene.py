@@ -213,3 +213,44 @@ def test_render_operator_and_overlay_registration(addon, gpu_context, tmp_path):
     assert not viewport_overlay._renderers
     scene.camera = None
     assert not bpy.ops.render.hao_render_ao.poll()
+
+
+def test_composite_darkens_by_ao_and_respects_depth(renderer):
+    """The overlay's composite: colour * (1 - (1 - AO) * strength) where the surface is the
+    front-most thing drawn; unchanged where something nearer was drawn, and on background."""
+    import gpu
+    from hao_addon.gpu import util
+    from hao_addon.gpu.hao_composite import draw_composite
+    from hao_addon.gpu.hao_gbuffer import GBufferPass
+
+    objs = _scene_objects()
+    vp, w, h = _view((2.0, -2.5, 2.0))
+    renderer.render(objs, vp, w, h, ViewAOSettings(rays=8, steps=8, grid=64))
+    ao = renderer.read_ao()
+    _, _, depth = renderer.gbuffer.read()
+    # "Blender's" depth buffer: the same meshes drawn again (so the surfaces are front-most),
+    # or a depth buffer cleared to 0 (something nearer everywhere).
+    viewport = GBufferPass()
+    viewport.set_geometry(np.concatenate([o.positions for o in objs]), np.concatenate([o.normals for o in objs]),
+                          np.ones(sum(len(o.positions) for o in objs), np.float32))
+    viewport.render(vp, w, h)
+    nearer_depth = gpu.types.GPUTexture((w, h), format='DEPTH_COMPONENT32F')
+    colour = gpu.types.GPUTexture((w, h), format='RGBA32F')
+    base = np.array([0.8, 0.6, 0.4])
+    for strength, scene_depth in ((1.0, viewport.depth), (0.5, viewport.depth), (1.0, nearer_depth)):
+        fb = gpu.types.GPUFrameBuffer(depth_slot=scene_depth, color_slots=colour)
+        with fb.bind():
+            if scene_depth is nearer_depth:
+                fb.clear(color=(*base, 1.0), depth=0.0)
+            else:
+                fb.clear(color=(*base, 1.0))
+            draw_composite(renderer.ao_texture, renderer.gbuffer.depth, strength)
+        got = util.texture_to_numpy(colour)[..., :3]
+        if scene_depth is nearer_depth:
+            expected = np.broadcast_to(base, got.shape)
+        else:
+            expected = base * (1.0 - (1.0 - ao) * strength)[..., None]
+        assert np.abs(got - expected).max() < 1e-5, strength
+        assert np.abs(got[depth >= 1.0] - base).max() < 1e-6
+    assert ao.min() < 0.8  # there was AO to composite
+    viewport.free()
