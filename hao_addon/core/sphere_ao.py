@@ -1,0 +1,84 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Ambient occlusion of sphere occluders (Shanmugam & Arikan 2007, section 5), pure numpy.
+
+The paper's occlusion of a receiver (P, n) by a sphere <C, r> (equations 2 and 3) is
+    A_psi = S_Omega(P, C, r) * max(n . PC_hat, 0),   S_Omega = 2 pi (1 - cos(asin(r / |PC|))),
+the solid angle of the sphere's cap times the cosine towards its centre. Divided by pi it is
+comparable with cosine-weighted occlusion (accessibility = 1 - occlusion). For a sphere wholly
+above the horizon the exact value is sin^2(theta) cos(alpha) (the sphere's form factor); the
+paper's 2 (1 - cos theta) cos(alpha) is that times 2 / (1 + cos theta): equal for small or
+distant spheres, up to 2x for a sphere close to the receiver. Spheres partly below the horizon are where the
+formula is only an approximation (tests/test_spheres.py measures it against quadrature).
+A receiver inside a sphere is fully occluded (A_psi = pi, occlusion 1), as in section 6.
+
+d_far (equation 5): the distance at which a sphere of radius r facing the receiver head-on
+occludes exactly epsilon:  d_far = r / sin(acos(1 - epsilon / (2 pi))).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def far_distance(radius: np.ndarray, epsilon: float) -> np.ndarray:
+    """d_far of equation 5 for sphere radii (any shape); epsilon in (0, 2 pi)."""
+    if not 0.0 < epsilon < 2.0 * np.pi:
+        raise ValueError(f"epsilon must be in (0, 2 pi), got {epsilon}")
+    return np.asarray(radius, np.float64) / np.sin(np.arccos(1.0 - epsilon / (2.0 * np.pi)))
+
+
+def sphere_occlusion(points: np.ndarray, normals: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarray:
+    """A_psi / pi (equations 2 and 3, as a fraction of the cosine-weighted hemisphere) of one
+    sphere at (n, 3) receivers with (n, 3) unit normals; 1 inside the sphere."""
+    pc = np.asarray(centre, np.float64) - np.asarray(points, np.float64)
+    dist = np.linalg.norm(pc, axis=-1)
+    inside = dist <= radius
+    safe = np.where(inside, 1.0, dist)
+    sin_t = np.clip(radius / safe, 0.0, 1.0)
+    solid_angle = 2.0 * np.pi * (1.0 - np.sqrt(1.0 - sin_t * sin_t))
+    cos_a = np.maximum((pc * np.asarray(normals, np.float64)).sum(-1) / safe, 0.0)
+    return np.where(inside, 1.0, solid_angle * cos_a / np.pi)
+
+
+def spheres_accessibility(points: np.ndarray, normals: np.ndarray, centres: np.ndarray, radii: np.ndarray,
+                          epsilon: float, combine: str = "multiply") -> np.ndarray:
+    """Accessibility (n,) under K spheres (K, 3), (K,), each cut off beyond its d_far.
+    combine: 'add' (the paper: 1 - min(sum, 1)) or 'multiply' (prod (1 - occlusion_i),
+    occluders treated as independent, which avoids the over-occlusion of overlapping ones)."""
+    points = np.asarray(points, np.float64)
+    reach = far_distance(radii, epsilon)
+    total = np.zeros(len(points)) if combine == "add" else np.ones(len(points))
+    for c, r, d in zip(np.asarray(centres, np.float64), np.asarray(radii, np.float64), reach):
+        near = np.linalg.norm(points - c, axis=1) <= d
+        occ = np.zeros(len(points))
+        occ[near] = sphere_occlusion(points[near], normals[near], c, r)
+        if combine == "add":
+            total += occ
+        elif combine == "multiply":
+            total *= 1.0 - np.minimum(occ, 1.0)
+        else:
+            raise ValueError(f"unknown combine '{combine}', expected 'add' or 'multiply'")
+    return 1.0 - np.minimum(total, 1.0) if combine == "add" else total
+
+
+def sphere_occlusion_quadrature(points: np.ndarray, normals: np.ndarray, centre: np.ndarray, radius: float,
+                                samples: int = 128) -> np.ndarray:
+    """Exact cosine-weighted occluded fraction of one sphere (horizon clipping included) by a
+    samples x samples midpoint rule on Malley's disk, for testing sphere_occlusion."""
+    from .ao_pattern import tangent_frames
+    k = (np.arange(samples) + 0.5) / samples
+    r = np.sqrt(k)[:, None]
+    phi = 2.0 * np.pi * k[None, :]
+    local = np.stack([np.broadcast_to(r * np.cos(phi), (samples, samples)),
+                      np.broadcast_to(r * np.sin(phi), (samples, samples)),
+                      np.broadcast_to(np.sqrt(1.0 - r * r), (samples, samples))], -1).reshape(-1, 3)
+    normals = np.asarray(normals, np.float64)
+    t, s = tangent_frames(normals)
+    out = np.empty(len(points))
+    for i, p in enumerate(np.asarray(points, np.float64)):
+        d = local @ np.stack([t[i], s[i], normals[i]])
+        oc = p - np.asarray(centre, np.float64)
+        b = d @ oc
+        disc = b * b - (oc @ oc - radius * radius)
+        hit = (disc > 0.0) & (-b + np.sqrt(np.maximum(disc, 0.0)) > 0.0)
+        out[i] = 1.0 if oc @ oc <= radius * radius else hit.mean()
+    return out
