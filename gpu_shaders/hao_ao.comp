@@ -18,14 +18,8 @@ void main()
   if (any(greaterThanEqual(low, low_size))) {
     return;
   }
-  /* The block's centre pixel, or else its first covered pixel (keeps silhouettes). */
-  ivec2 base = low * scale;
-  ivec2 pick = min(base + scale / 2, full_size - 1);
-  vec4 p = imageLoad(gbuf_position, pick);
-  for (int k = 0; k < scale * scale && p.w == 0.0; k++) {
-    pick = min(base + ivec2(k % scale, k / scale), full_size - 1);
-    p = imageLoad(gbuf_position, pick);
-  }
+  vec4 p;
+  ivec2 pick = pick_gbuffer_pixel(low, p);
   float voxel = grid_origin.w;
   vec3 g0 = (p.xyz - grid_origin.xyz) / voxel;
   /* Background, objects with a baked map, and points outside the region: nothing to do. */

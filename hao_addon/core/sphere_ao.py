@@ -9,7 +9,13 @@ above the horizon the exact value is sin^2(theta) cos(alpha) (the sphere's form 
 paper's 2 (1 - cos theta) cos(alpha) is that times 2 / (1 + cos theta): equal for small or
 distant spheres, up to 2x for a sphere close to the receiver. Spheres partly below the horizon are where the
 formula is only an approximation (tests/test_spheres.py measures it against quadrature).
-A receiver inside a sphere is fully occluded (A_psi = pi, occlusion 1), as in section 6.
+Inside a sphere. Section 6 sets A_psi = 1 there to keep the near and far passes apart. On a
+character, receivers lie on the surface of their own cluster, about half of them inside its
+proxy sphere, and a constant would switch them between open and fully dark across the sphere's
+boundary. Here the distance is clamped to r instead: the cap becomes the whole hemisphere
+(S = 2 pi) and the occlusion min(2 max(n . PC_hat, 0), 1), continuous at the boundary: a
+receiver facing away from the centre (an outer surface) is open, one facing it (inside a
+fold) is dark.
 
 d_far (equation 5): the distance at which a sphere of radius r facing the receiver head-on
 occludes exactly epsilon:  d_far = r / sin(acos(1 - epsilon / (2 pi))).
@@ -27,16 +33,16 @@ def far_distance(radius: np.ndarray, epsilon: float) -> np.ndarray:
 
 
 def sphere_occlusion(points: np.ndarray, normals: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarray:
-    """A_psi / pi (equations 2 and 3, as a fraction of the cosine-weighted hemisphere) of one
-    sphere at (n, 3) receivers with (n, 3) unit normals; 1 inside the sphere."""
+    """A_psi / pi (equations 2 and 3, as a fraction of the cosine-weighted hemisphere, at most
+    1) of one sphere at (n, 3) receivers with (n, 3) unit normals; inside the sphere the
+    distance is clamped to the radius (module docstring)."""
     pc = np.asarray(centre, np.float64) - np.asarray(points, np.float64)
     dist = np.linalg.norm(pc, axis=-1)
-    inside = dist <= radius
-    safe = np.where(inside, 1.0, dist)
-    sin_t = np.clip(radius / safe, 0.0, 1.0)
+    safe = np.maximum(dist, 1e-300)
+    sin_t = np.clip(radius / np.maximum(safe, radius), 0.0, 1.0)
     solid_angle = 2.0 * np.pi * (1.0 - np.sqrt(1.0 - sin_t * sin_t))
     cos_a = np.maximum((pc * np.asarray(normals, np.float64)).sum(-1) / safe, 0.0)
-    return np.where(inside, 1.0, solid_angle * cos_a / np.pi)
+    return np.where(dist > 0.0, np.minimum(solid_angle * cos_a / np.pi, 1.0), 1.0)
 
 
 def spheres_accessibility(points: np.ndarray, normals: np.ndarray, centres: np.ndarray, radii: np.ndarray,

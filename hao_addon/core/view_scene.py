@@ -19,13 +19,15 @@ class SceneObject:
     """positions, normals: (F, 3, 3) float32 world corners and corner normals.
     key: anything hashable that changes whenever the geometry or transform does.
     receiver: 1.0 gets AO; 0.5 has a baked AO map (skipped by HAO, still occludes).
-    solid: also voxelized by parity (closed or nearly closed)."""
+    solid: also voxelized by parity (closed or nearly closed).
+    proxied: has sphere proxies (left out of the voxels when they stand in for it)."""
     name: str
     key: object
     positions: np.ndarray
     normals: np.ndarray
     receiver: float = 1.0
     solid: bool = False
+    proxied: bool = False
 
 
 def object_from_soup(soup: TriangleSoup, key: object = 0, receiver: float = 1.0) -> SceneObject:

@@ -10,6 +10,9 @@ from dataclasses import dataclass, replace
 from .plan import BakeInputError
 
 GRID_MIN, GRID_MAX = 64, 512
+# 'hao': voxel AO (everything); 'far': sphere proxies only; 'hao+far': voxels for the objects
+# without proxies and spheres for those with them (each occluder counted once).
+METHODS = ("hao", "far", "hao+far")
 
 
 @dataclass(frozen=True)
@@ -22,6 +25,8 @@ class ViewAOSettings:
     scale: int = 2             # AO map is 1/scale of the screen per axis (k)
     filter_size: int = 16      # bilateral window m (full-resolution pixels)
     strength: float = 1.0      # viewport only: 0 = no darkening, 1 = the computed AO
+    method: str = "hao"
+    epsilon: float = 0.05      # sphere influence cut-off (A_psi units, paper eq. 5): d_far ~ 7.9 r
 
     def validated(self) -> "ViewAOSettings":
         """Self, or BakeInputError naming the first bad value."""
@@ -35,6 +40,8 @@ class ViewAOSettings:
             (1 <= self.scale <= 8, f"scale must be 1..8, got {self.scale}"),
             (0 <= self.filter_size <= 64, f"filter size must be 0..64, got {self.filter_size}"),
             (0.0 <= self.strength <= 1.0, f"strength must be 0..1, got {self.strength}"),
+            (self.method in METHODS, f"method must be one of {', '.join(METHODS)}, got '{self.method}'"),
+            (0.0 < self.epsilon < 1.0, f"epsilon must be in (0, 1), got {self.epsilon}"),
         ]
         for ok, message in checks:
             if not ok:

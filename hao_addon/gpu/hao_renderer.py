@@ -27,6 +27,7 @@ from . import util
 from .hao_gbuffer import GBufferPass
 from .hao_sampling import AOSamplingPass, BilateralPass
 from .hao_voxelize import VoxelPass
+from .sphere_far import FarSpheresPass
 
 
 def _box_overlaps(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
@@ -44,6 +45,7 @@ class HaoRenderer(util.GPUPass):
         self.gbuffer = GBufferPass()
         self.sampling = AOSamplingPass()
         self.filter = BilateralPass()
+        self.far = FarSpheresPass()
         self.stats: Counter = Counter()
         self._keys: dict[str, object] = {}
         self.spec: GridSpec | None = None
@@ -55,21 +57,28 @@ class HaoRenderer(util.GPUPass):
         return True
 
     def render(self, objects: list[SceneObject], view_proj: np.ndarray, width: int, height: int,
-               settings: ViewAOSettings, region: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+               settings: ViewAOSettings, region: tuple[np.ndarray, np.ndarray] | None = None,
+               spheres: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Run what changed since the last call. view_proj: (4, 4) world -> clip;
-        region: world box (lo, hi) of the region of interest, default the objects' bounds."""
+        region: world box (lo, hi) of the region of interest, default the objects' bounds;
+        spheres: (centres (K, 3), radii (K,)) sphere proxies for the 'far' methods."""
         settings = settings.validated()
         if width < 1 or height < 1:
             raise BakeInputError(f"image size must be positive, got {width}x{height}")
         self.stats["frames"] += 1
+        # With 'hao+far' the spheres stand in for the objects that have them: those are drawn
+        # and receive AO but are not voxelized, so no occluder is counted twice.
+        voxelized = [o for o in objects if not (settings.method == "hao+far" and o.proxied)]
         geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
-        if self._changed("geometry", geometry_key):
+        if self._changed("geometry", (geometry_key, tuple(o.name for o in voxelized))):
             pos = (np.concatenate([o.positions for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
             nrm = (np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
             flags = np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects]) \
                 if objects else np.zeros(0, np.float32)
-            solid = np.concatenate([np.full(len(o.positions), o.solid) for o in objects]) if objects else np.zeros(0, bool)
-            self.voxels.set_geometry(pos, dominant_axes(pos), solid)
+            vpos = (np.concatenate([o.positions for o in voxelized]) if voxelized else np.zeros((0, 3, 3), np.float32))
+            solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
+                     else np.zeros(0, bool))
+            self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
             self.gbuffer.set_geometry(pos, nrm, flags)
             self.stats["upload"] += 1
         bounds = region if region is not None else scene_bounds(objects)
@@ -79,20 +88,34 @@ class HaoRenderer(util.GPUPass):
         # Only objects reaching into the region can change the grid: one moving outside a
         # user region re-renders the G-buffer but is not re-voxelized.
         lo, hi = np.asarray(self.spec.origin), np.asarray(self.spec.origin) + np.asarray(self.spec.dims) * self.spec.voxel
-        inside = tuple(k for o, k in zip(objects, geometry_key) if _box_overlaps(o.positions, lo, hi))
+        inside = tuple(k for o, k in zip(objects, geometry_key)
+                       if o in voxelized and _box_overlaps(o.positions, lo, hi))
         grid_key = (inside, self.spec)
-        if self._changed("grid", grid_key):
+        use_voxels = settings.method in ("hao", "hao+far")
+        if use_voxels and self._changed("grid", grid_key):
             self.voxels.voxelize(self.spec)
             self.stats["voxelize"] += 1
         view_key = (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height)
         if self._changed("view", view_key):
             self.gbuffer.render(view_proj, width, height)
             self.stats["gbuffer"] += 1
-        ao_key = (grid_key, view_key, settings.rays, settings.steps, settings.spread, settings.max_distance,
-                  settings.scale)
+        use_spheres = settings.method in ("far", "hao+far")
+        if use_spheres and spheres is None:
+            raise BakeInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
+        sphere_key = ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes(),
+                       settings.epsilon) if use_spheres else None)
+        ao_key = (settings.method, grid_key if use_voxels else None, view_key, sphere_key, settings.scale,
+                  (settings.rays, settings.steps, settings.spread, settings.max_distance) if use_voxels else None)
         if self._changed("ao", ao_key):
-            self.sampling.run(self.gbuffer, self.voxels, settings)
-            self.stats["ao"] += 1
+            if use_voxels:
+                self.sampling.run(self.gbuffer, self.voxels, settings)
+                self.stats["ao"] += 1
+            else:
+                self.sampling.clear(self.gbuffer, settings.scale)
+            if use_spheres:
+                self.far.run(self.gbuffer, self.sampling.ao_low, settings.scale, spheres[0], spheres[1],
+                             settings.epsilon, view_proj)
+                self.stats["far"] += 1
         if self._changed("filter", (ao_key, settings.filter_size)):
             self.filter.run(self.gbuffer, self.sampling.ao_low, settings)
             self.stats["filter"] += 1
@@ -110,6 +133,6 @@ class HaoRenderer(util.GPUPass):
         return self.sampling.sampled_pixels()
 
     def _release(self) -> None:
-        for p in (self.voxels, self.gbuffer, self.sampling, self.filter):
+        for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far):
             p.free()
         self._keys.clear()

@@ -28,7 +28,7 @@ def _ao_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(2, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
     info.image(4, 'R32UI', 'UINT_2D', "sampled_count", qualifiers={'READ', 'WRITE'})
-    info.compute_source(glsl_source("hao_common.glsl", "hao_ao.comp"))
+    info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "hao_ao.comp"))
     return info
 
 
@@ -75,13 +75,25 @@ class AOSamplingPass(util.GPUPass):
         self.low_size = (0, 0)
         self.counter = None
 
-    def run(self, gbuffer, voxels, settings: ViewAOSettings) -> None:
+    def _ensure(self, gbuffer, k: int) -> tuple[int, int]:
         width, height = gbuffer.size
-        k = settings.scale
         low = (-(-width // k), -(-height // k))
         if self.low_size != low:
             self.ao_low = gpu.types.GPUTexture(low, format='R32F')
             self.low_size = low
+        return low
+
+    def clear(self, gbuffer, k: int) -> None:
+        """An AO map of 1s (open everywhere), for passes that only multiply into it."""
+        self._ensure(gbuffer, k)
+        self.ao_low.clear(format='FLOAT', value=(1.0,))
+        if self.counter is not None:
+            self.counter.clear(format='UINT', value=(0,))
+
+    def run(self, gbuffer, voxels, settings: ViewAOSettings) -> None:
+        width, height = gbuffer.size
+        k = settings.scale
+        low = self._ensure(gbuffer, k)
         if self.counter is None:
             self.counter = gpu.types.GPUTexture((1, 1), format='R32UI')
         self.counter.clear(format='UINT', value=(0,))
@@ -108,6 +120,8 @@ class AOSamplingPass(util.GPUPass):
         return util.texture_to_numpy(self.ao_low)
 
     def sampled_pixels(self) -> int:
+        if self.counter is None:
+            return 0
         return int(util.texture_to_numpy(self.counter, np.uint32).ravel()[0])
 
     def _release(self) -> None:

@@ -1,0 +1,25 @@
+/* Occlusion of one sphere at the AO-map pixel's surface point, by the paper's equations 2
+ * and 3 (A_psi / pi as a fraction of the cosine-weighted hemisphere), cut off beyond d_far. Multiplicative blending into the AO map: A *= 1 - occlusion. */
+void main()
+{
+  vec4 p;
+  ivec2 pick = pick_gbuffer_pixel(ivec2(gl_FragCoord.xy), p);
+  if (p.w < 1.0) {
+    discard;
+  }
+  vec3 pc = sphere_data.xyz - p.xyz;
+  float dist = length(pc);
+  if (dist > sphere_reach) {
+    discard;
+  }
+  /* Inside the sphere the distance is clamped to r (see hao_addon/core/sphere_ao.py). */
+  float r = sphere_data.w;
+  float occlusion = 1.0;
+  if (dist > 0.0) {
+    vec3 n = imageLoad(gbuf_normal, pick).xyz;
+    float sin_t = min(r / max(dist, r), 1.0);
+    float solid_angle = 6.283185307179586 * (1.0 - sqrt(max(1.0 - sin_t * sin_t, 0.0)));
+    occlusion = min(solid_angle * max(dot(n, pc) / dist, 0.0) / 3.141592653589793, 1.0);
+  }
+  far_out = vec4(1.0 - occlusion);
+}

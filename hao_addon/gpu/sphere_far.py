@@ -1,0 +1,94 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Distant-occluder pass (Shanmugam & Arikan, section 5): sphere proxies splatted as
+billboards that multiply their occlusion into the AO map (fragment pass).
+
+Why multiplicative: adding the occlusion of overlapping spheres counts the directions they
+share twice (the paper's over-occlusion, clamped at 1); treating them as independent
+occluders, A = prod (1 - o_i), stays within [0, 1] and is closer to the ray-traced answer
+(tests/test_spheres_gpu.py measures both on a cluster of spheres over a floor)."""
+from __future__ import annotations
+
+import gpu
+import numpy as np
+
+from ..core.sphere_ao import far_distance
+from . import util
+from .shaders import cached_shader, glsl_source
+
+
+def _far_info() -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo("hao_sphere_far_iface")
+    iface.flat('VEC4', "sphere_data")
+    iface.flat('FLOAT', "sphere_reach")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC2', "corner")
+    info.vertex_in(1, 'VEC4', "sphere")
+    info.vertex_in(2, 'FLOAT', "reach")
+    info.vertex_out(iface)
+    info.push_constant('IVEC2', "full_size")
+    info.push_constant('INT', "scale")
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    info.fragment_out(0, 'VEC4', "far_out")
+    info.vertex_source(glsl_source("sphere_far.vert"))
+    info.fragment_source(glsl_source("hao_pick.glsl", "sphere_far.frag"))
+    return info
+
+
+def far_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("hao_sphere_far",), _far_info)
+
+
+def billboard_rectangles(centres: np.ndarray, reach: np.ndarray, view_proj: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """NDC rectangles (K, 4) = (x0, y0, x1, y1) conservatively covering the projection of each
+    ball (centre, reach), and a (K,) mask of those that touch the screen. A ball reaching
+    behind the camera plane covers the whole screen."""
+    offsets = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], np.float64)
+    corners = centres[:, None, :] + reach[:, None, None] * offsets[None]  # the cube around the ball
+    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], axis=2) @ np.asarray(view_proj, np.float64).T
+    w = clip[..., 3]
+    behind = (w <= 1e-9).any(axis=1)
+    ndc = clip[..., :2] / np.where(w > 1e-9, w, 1.0)[..., None]
+    rect = np.concatenate([ndc.min(axis=1), ndc.max(axis=1)], axis=1)
+    rect[behind] = (-1.0, -1.0, 1.0, 1.0)
+    rect = np.clip(rect, -1.0, 1.0)
+    visible = (rect[:, 2] > rect[:, 0]) & (rect[:, 3] > rect[:, 1])
+    return rect, visible
+
+
+class FarSpheresPass(util.GPUPass):
+    """Multiplies sphere occlusion into an AO map texture (R32F at the AO-map resolution)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.stats = dict(spheres_drawn=0, spheres_culled=0)
+
+    def run(self, gbuffer, ao_map, scale: int, centres: np.ndarray, radii: np.ndarray, epsilon: float,
+            view_proj: np.ndarray) -> None:
+        """ao_map: R32F texture of ceil(size / scale), already holding an accessibility (1s for
+        spheres alone, or the HAO result to combine with)."""
+        centres = np.asarray(centres, np.float64).reshape(-1, 3)
+        radii = np.asarray(radii, np.float64).reshape(-1)
+        reach = far_distance(radii, epsilon)
+        rect, visible = billboard_rectangles(centres, reach, view_proj)
+        keep = visible & (radii > 0.0)
+        self.stats = dict(spheres_drawn=int(keep.sum()), spheres_culled=int((~keep).sum()))
+        if not keep.any():
+            return
+        r = rect[keep]
+        quad = np.array([[0, 1], [2, 1], [2, 3], [0, 1], [2, 3], [0, 3]])  # (x index, y index) per vertex
+        corners = np.stack([r[:, quad[:, 0]], r[:, quad[:, 1]]], axis=2).reshape(-1, 2)
+        sphere = np.repeat(np.concatenate([centres[keep], radii[keep, None]], axis=1), 6, axis=0)
+        batch = util.make_batch('TRIS', {"corner": ('F32', corners), "sphere": ('F32', sphere),
+                                         "reach": ('F32', np.repeat(reach[keep], 6))})
+        width, height = gbuffer.size
+        fb = gpu.types.GPUFrameBuffer(color_slots=ao_map)
+        with util.scoped_state(), fb.bind():
+            util.set_overlay_pass_state(ao_map.width, ao_map.height, blend='MULTIPLY')
+            shader = far_shader()
+            shader.bind()
+            shader.uniform_int("full_size", (width, height))
+            shader.uniform_int("scale", scale)
+            shader.image("gbuf_position", gbuffer.position)
+            shader.image("gbuf_normal", gbuffer.normal)
+            batch.draw(shader)

@@ -1,0 +1,65 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The distant-occluder pass on the GPU against its numpy reference, and its combination
+rule against ray-traced ground truth."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hao_addon.core import scenes
+from hao_addon.core.reference import reference_accessibility
+from hao_addon.core.sphere_ao import spheres_accessibility
+from hao_addon.core.view_scene import object_from_soup
+from hao_addon.core.view_settings import ViewAOSettings
+from test_hao import low_res_samples, view
+
+CENTRES = np.array([[0.0, 0.0, 0.45], [0.55, 0.1, 0.3], [0.35, 0.45, 0.4], [-0.5, 0.3, 0.25], [0.2, -0.5, 0.5]])
+RADII = np.array([0.45, 0.3, 0.32, 0.25, 0.3])
+
+
+def _scene():
+    floor = scenes.grid_plane(4.0, 8, name="floor")
+    balls = [scenes.uv_sphere(r, c, 48, 24, name=f"ball{i}") for i, (c, r) in enumerate(zip(CENTRES, RADII))]
+    objs = [object_from_soup(floor, "floor")] + [object_from_soup(b, b.name) for b in balls]
+    return objs, [floor] + balls
+
+
+@pytest.fixture
+def renderer(gpu_context):
+    from hao_addon.gpu.hao_renderer import HaoRenderer
+    r = HaoRenderer()
+    yield r
+    r.free()
+
+
+def test_far_pass_equals_numpy_reference(renderer):
+    objs, _ = _scene()
+    settings = ViewAOSettings(method="far", epsilon=0.02, filter_size=0)
+    vp, w, h = view((2.2, -2.6, 2.4), target=(0.0, 0.0, 0.2))
+    renderer.render(objs, vp, w, h, settings, spheres=(CENTRES, RADII))
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    ref = spheres_accessibility(pts, nrm, CENTRES, RADII, settings.epsilon, "multiply")
+    assert np.abs(ao - ref).max() < 1e-4
+    assert ao.min() < 0.5 and renderer.far.stats["spheres_drawn"] == 5
+    # Spheres off screen are culled before drawing.
+    far_away = np.vstack([CENTRES, [[40.0, 40.0, 0.0]]])
+    renderer.render(objs, vp, w, h, settings, spheres=(far_away, np.append(RADII, 0.2)))
+    assert renderer.far.stats == dict(spheres_drawn=5, spheres_culled=1)
+
+
+def test_multiplicative_combination_is_closer_to_ground_truth(renderer):
+    """Floor points around five overlapping spheres: unlimited-distance ray-traced AO against
+    the spheres' AO combined by the paper's clamped sum and by the product. Measured: sum
+    RMSE 0.053 (over-occlusion where spheres overlap), product 0.037."""
+    objs, soups = _scene()
+    settings = ViewAOSettings(method="far", epsilon=0.005, filter_size=0)
+    vp, w, h = view((0.01, -0.01, 4.5), target=(0.0, 0.0, 0.0), width=128, height=128)
+    renderer.render(objs, vp, w, h, settings, spheres=(CENTRES, RADII))
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    floor = np.abs(pts[:, 2]) < 1e-4
+    pts, nrm, ao = pts[floor], nrm[floor], ao[floor]
+    gt = reference_accessibility(pts, nrm, np.concatenate([s.positions for s in soups]), rays=256, seed=2)
+    added = spheres_accessibility(pts, nrm, CENTRES, RADII, settings.epsilon, "add")
+    rmse = {name: float(np.sqrt(((a - gt) ** 2).mean())) for name, a in (("add", added), ("multiply", ao))}
+    assert rmse["multiply"] < rmse["add"]
+    assert rmse["multiply"] < 0.06
