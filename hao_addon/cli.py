@@ -65,6 +65,11 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--filter", type=int, default=16, help="bilateral filter size in pixels (default 16)")
     r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
     r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
+    r.add_argument("--method", choices=("hao", "far", "hao+far"), default="hao",
+                   help="hao: voxels (default); far: sphere proxies; hao+far: spheres for armature meshes, voxels for the rest")
+    r.add_argument("--spheres", type=int, default=0,
+                   help="sync K sphere proxies on every mesh with an Armature modifier first (0: use those stored)")
+    r.add_argument("--epsilon", type=float, default=0.05, help="sphere influence cut-off (default 0.05)")
     r.add_argument("--quiet", action="store_true")
     return parser
 
@@ -162,7 +167,15 @@ def run_render_ao(args) -> int:
     else:
         camera = scene.camera
     settings = ViewAOSettings(rays=args.rays, steps=args.steps, spread=args.spread, max_distance=args.max_distance,
-                              grid=args.grid, scale=args.scale, filter_size=args.filter)
+                              grid=args.grid, scale=args.scale, filter_size=args.filter, method=args.method,
+                              epsilon=args.epsilon).validated()
+    if args.spheres:
+        from .blender.sphere_proxies import has_armature, make_proxies
+        rigged = [o for o in scene.objects if o.type == 'MESH' and has_armature(o)]
+        if not rigged:
+            raise CLIError("--spheres: no mesh with an Armature modifier in the scene")
+        for obj in rigged:
+            make_proxies(obj, args.spheres)
     t0 = time.perf_counter()
     rgba = render_camera_ao(scene, camera, args.width, args.height, settings, skip_baked=args.skip_baked)
     write_ao_file(out, rgba)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from .blender.sphere_proxies import scene_spheres
 from .blender.view_scene import camera_view_projection, visible_scene_objects
 from .core.plan import BakeInputError
 from .core.view_settings import ViewAOSettings
@@ -29,11 +30,14 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)
     if not objects:
         raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects")
+    spheres, proxied = scene_spheres(view_layer, depsgraph) if settings.method != "hao" else (None, set())
+    for obj in objects:
+        obj.proxied = obj.name in proxied
     view_proj = camera_view_projection(camera, depsgraph, width, height)
     own = renderer is None
     renderer = renderer or HaoRenderer()
     try:
-        renderer.render(objects, view_proj, width, height, settings, region)
+        renderer.render(objects, view_proj, width, height, settings, region, spheres)
         ao = renderer.read_ao()
         coverage = renderer.gbuffer.read()[0][..., 3] > 0.0
     finally:

@@ -81,6 +81,13 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         elif props.region_mode == 'BOX':
             col.prop(props, "region_object")
         col.prop(props, "skip_baked")
+        col.separator()
+        col.prop(props, "method")
+        col.prop(props, "epsilon")
+        col.prop(props, "show_spheres")
+        row = layout.row(align=True)
+        row.operator("object.hao_sync_spheres", icon='MESH_UVSPHERE')
+        row.operator("object.hao_clear_spheres", text="", icon='X')
         layout.separator()
         layout.operator("render.hao_render_ao", icon='RENDER_STILL')
 

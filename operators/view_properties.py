@@ -49,6 +49,17 @@ class HAO_PG_view_settings(bpy.types.PropertyGroup):
                                        description="Collection whose bounds are the region", update=_redraw)
     region_object: PointerProperty(type=bpy.types.Object, name="Box", description="Object whose bounds are the region",
                                    update=_redraw)
+    method: EnumProperty(
+        name="Method", description="What casts the AO (see the README's benchmark for time against error)",
+        items=(('hao', "HAO Voxels", "Voxel ray-marching against everything (static and deforming)"),
+               ('far', "Sphere Proxies", "Only the sphere proxies of characters (fast, coarse)"),
+               ('hao+far', "Voxels + Spheres", "Spheres for meshes that have proxies, voxels for the rest")),
+        default='hao', update=_redraw)
+    epsilon: FloatProperty(name="Sphere Cut-off", description="Occlusion below which a sphere proxy stops "
+                                                              "influencing (paper's epsilon): smaller reaches farther",
+                           default=0.05, min=1e-4, max=0.99, update=_redraw)
+    show_spheres: BoolProperty(name="Show Spheres", description="Draw the sphere proxies in the viewport",
+                               default=False, update=_redraw)
     skip_baked: BoolProperty(
         name="Skip Baked Objects", description="Objects with a baked AO map (from Bake AO) still occlude but get "
                                                "no HAO of their own (the paper's static regions)",
@@ -56,7 +67,8 @@ class HAO_PG_view_settings(bpy.types.PropertyGroup):
 
     def to_settings(self) -> ViewAOSettings:
         return ViewAOSettings(rays=self.rays, steps=self.steps, spread=self.spread, max_distance=self.max_distance,
-                              grid=self.grid, scale=self.scale, filter_size=self.filter_size, strength=self.strength)
+                              grid=self.grid, scale=self.scale, filter_size=self.filter_size, strength=self.strength,
+                              method=self.method, epsilon=self.epsilon)
 
 
 def register() -> None:

@@ -35,6 +35,7 @@ def draw_overlay() -> None:
     region, rv3d = context.region, context.region_data
     if region is None or rv3d is None:
         return
+    from ..hao_addon.blender.sphere_proxies import scene_spheres
     from ..hao_addon.blender.view_scene import region_box, visible_scene_objects
     from ..hao_addon.gpu.hao_composite import draw_composite
     from ..hao_addon.gpu.hao_renderer import HaoRenderer
@@ -48,12 +49,17 @@ def draw_overlay() -> None:
             _scene_dirty = False
         if not _cached_objects:
             return
+        settings = props.to_settings()
+        spheres, proxied = (scene_spheres(context.view_layer, context.evaluated_depsgraph_get())
+                            if settings.method != "hao" else (None, set()))
+        for obj in _cached_objects:
+            obj.proxied = obj.name in proxied
         renderer = _renderers.get(region.as_pointer())
         if renderer is None:
             renderer = _renderers[region.as_pointer()] = HaoRenderer()
         view_proj = np.array(rv3d.perspective_matrix)
-        renderer.render(_cached_objects, view_proj, region.width, region.height, props.to_settings(),
-                        region_box(props))
+        renderer.render(_cached_objects, view_proj, region.width, region.height, settings,
+                        region_box(props), spheres)
         draw_composite(renderer.ao_texture, renderer.gbuffer.depth, props.strength)
         _last_error = ""
     except Exception as exc:  # never break the viewport: report once, then keep drawing

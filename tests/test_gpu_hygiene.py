@@ -43,6 +43,8 @@ def test_every_shader_variant_compiles(gpu_context):
     for axis in (0, 1):
         hao_addon_shaders.append(hao_sampling.bilateral_shader(axis, axis == 0))
     cached_shader(("hao_composite",), hao_composite._composite_info)
+    from hao_addon.gpu import sphere_far
+    sphere_far.far_shader()
     # Every file in gpu_shaders/ is used by some pass (no dead shader text ships).
     sources = "".join(p.read_text() for p in (shaders.SHADER_DIR.parent / "hao_addon").rglob("*.py"))
     for path in shaders.SHADER_DIR.iterdir():
@@ -51,9 +53,10 @@ def test_every_shader_variant_compiles(gpu_context):
 
 def test_registration_needs_no_gpu_and_is_symmetric(addon):
     import bpy
-    from hao_ext.operators import cli_command, viewport_overlay
+    from hao_ext.operators import cli_command, sphere_operators, viewport_overlay
     from hao_ext.operators.properties import HAO_PG_bake_settings
-    names = ("OBJECT_OT_hao_bake_ao", "VIEW3D_PT_hao_bake", "RENDER_OT_hao_render_ao", "VIEW3D_PT_hao_view")
+    names = ("OBJECT_OT_hao_bake_ao", "VIEW3D_PT_hao_bake", "RENDER_OT_hao_render_ao", "VIEW3D_PT_hao_view",
+             "OBJECT_OT_hao_sync_spheres", "OBJECT_OT_hao_clear_spheres")
     handler_lists = (bpy.app.handlers.depsgraph_update_post, bpy.app.handlers.frame_change_post,
                      bpy.app.handlers.load_post)
     counts = [len(h) for h in handler_lists]
@@ -64,6 +67,7 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
     assert not any(hasattr(bpy.types, n) for n in names)
     assert not HAO_PG_bake_settings.is_registered
     assert cli_command._handle is None and viewport_overlay._draw_handle is None
+    assert sphere_operators._draw_handle is None
     assert [len(h) for h in handler_lists] == [c - 1 for c in counts]
     addon.register()
     assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
