@@ -65,8 +65,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--filter", type=int, default=16, help="bilateral filter size in pixels (default 16)")
     r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
     r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
-    r.add_argument("--method", choices=("hao", "far", "hao+far"), default="hao",
-                   help="hao: voxels (default); far: sphere proxies; hao+far: spheres for armature meshes, voxels for the rest")
+    r.add_argument("--method", choices=("hao", "near", "far", "near+far", "hao+far"), default="hao",
+                   help="hao: voxels (default); near: image-space near field within --max-distance (--rays samples); "
+                        "far: sphere proxies; near+far: both; hao+far: spheres for armature meshes, voxels for the rest")
     r.add_argument("--spheres", type=int, default=0,
                    help="sync K sphere proxies on every mesh with an Armature modifier first (0: use those stored)")
     r.add_argument("--epsilon", type=float, default=0.05, help="sphere influence cut-off (default 0.05)")

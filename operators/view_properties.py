@@ -53,7 +53,10 @@ class HAO_PG_view_settings(bpy.types.PropertyGroup):
         name="Method", description="What casts the AO (see the README's benchmark for time against error)",
         items=(('hao', "HAO Voxels", "Voxel ray-marching against everything (static and deforming)"),
                ('far', "Sphere Proxies", "Only the sphere proxies of characters (fast, coarse)"),
-               ('hao+far', "Voxels + Spheres", "Spheres for meshes that have proxies, voxels for the rest")),
+               ('hao+far', "Voxels + Spheres", "Spheres for meshes that have proxies, voxels for the rest"),
+               ('near', "Near Field", "Image-space AO from the two depth layers within Distance (Rays = samples); "
+                                      "misses what is off screen"),
+               ('near+far', "Near Field + Spheres", "Near field plus the sphere proxies (the paper's combination)")),
         default='hao', update=_redraw)
     epsilon: FloatProperty(name="Sphere Cut-off", description="Occlusion below which a sphere proxy stops "
                                                               "influencing (paper's epsilon): smaller reaches farther",

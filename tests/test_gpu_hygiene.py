@@ -43,8 +43,10 @@ def test_every_shader_variant_compiles(gpu_context):
     for axis in (0, 1):
         hao_addon_shaders.append(hao_sampling.bilateral_shader(axis, axis == 0))
     cached_shader(("hao_composite",), hao_composite._composite_info)
-    from hao_addon.gpu import sphere_far
+    from hao_addon.gpu import near_field, sphere_far
     sphere_far.far_shader()
+    near_field.near_shader()
+    hao_gbuffer.gbuffer_shader(back_layer=True)
     # Every file in gpu_shaders/ is used by some pass (no dead shader text ships).
     sources = "".join(p.read_text() for p in (shaders.SHADER_DIR.parent / "hao_addon").rglob("*.py"))
     for path in shaders.SHADER_DIR.iterdir():

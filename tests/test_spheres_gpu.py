@@ -63,3 +63,48 @@ def test_multiplicative_combination_is_closer_to_ground_truth(renderer):
     rmse = {name: float(np.sqrt(((a - gt) ** 2).mean())) for name, a in (("add", added), ("multiply", ao))}
     assert rmse["multiply"] < rmse["add"]
     assert rmse["multiply"] < 0.06
+
+
+def _sphere_on_plane():
+    sphere = scenes.uv_sphere(0.5, (0.0, 0.0, 0.5), 64, 32, name="sphere")
+    plane = scenes.grid_plane(8.0, 16, name="plane")
+    return [object_from_soup(plane, "plane"), object_from_soup(sphere, "sphere")]
+
+
+def test_near_field_pass_equals_numpy_mirror(renderer):
+    from hao_addon.core.near_field import near_field_reference
+    settings = ViewAOSettings(method="near", rays=12, max_distance=1.5, filter_size=0)
+    vp, w, h = view((2.0, -2.4, 1.8), target=(0.0, 0.0, 0.3), width=96, height=72)
+    renderer.render(_sphere_on_plane(), vp, w, h, settings)
+    front = renderer.gbuffer.read()
+    back = renderer.back.read()
+    low = renderer.sampling.read()
+    ly, lx = np.mgrid[0:low.shape[0], 0:low.shape[1]]
+    picks = np.stack([np.minimum(lx * 2 + 1, w - 1), np.minimum(ly * 2 + 1, h - 1)], -1).reshape(-1, 2)
+    valid = front[0][picks[:, 1], picks[:, 0], 3] >= 1.0
+    ref = near_field_reference(front[0], front[1], back[0], back[1], picks[valid], vp, settings.max_distance,
+                               settings.rays)
+    got = low.reshape(-1)[valid]
+    diff = np.abs(got - ref)
+    # float32 against float64: a sample rounding to the neighbouring pixel changes one term.
+    assert np.mean(diff > 1e-3) < 0.02 and np.median(diff) < 1e-5
+    assert got.min() < 0.7
+
+
+def test_near_field_sphere_on_plane_against_analytic(renderer):
+    """Plane points in front of a resting sphere (0.55 < rho < 1, on the camera's side):
+    near-field AO from both layers, r_far covering the sphere, against 1 - (R/D)^3.
+    The estimate is a random subset of the disk's pixels: its noise falls as 1/sqrt(M)
+    (measured RMSE 0.13 at M = 64, 0.065 at 256, 0.037 at 1024), over a systematic +0.017
+    (patches seen at grazing angles from the camera are counted with at most 5x a pixel's
+    area). Bounds at M = 1024: RMSE 0.05, |bias| 0.025."""
+    settings = ViewAOSettings(method="near", rays=1024, max_distance=1.5, filter_size=0)
+    vp, w, h = view((0.0, -3.0, 1.0), target=(0.0, 0.0, 0.2), width=240, height=180, fov=1.0)
+    renderer.render(_sphere_on_plane(), vp, w, h, settings)
+    pts, nrm, ao = low_res_samples(renderer, settings)
+    rho = np.hypot(pts[:, 0], pts[:, 1])
+    ring = (np.abs(pts[:, 2]) < 1e-3) & (rho > 0.55) & (rho < 1.0) & (pts[:, 1] < 0.0)
+    exact = scenes.sphere_on_plane_accessibility(np.sqrt(rho[ring] ** 2 + 0.25), 0.5)
+    e = ao[ring] - exact
+    assert ring.sum() > 300 and exact.min() < 0.7
+    assert np.sqrt((e * e).mean()) < 0.05 and abs(e.mean()) < 0.025

@@ -11,8 +11,9 @@ from .plan import BakeInputError
 
 GRID_MIN, GRID_MAX = 64, 512
 # 'hao': voxel AO (everything); 'far': sphere proxies only; 'hao+far': voxels for the objects
-# without proxies and spheres for those with them (each occluder counted once).
-METHODS = ("hao", "far", "hao+far")
+# without proxies and spheres for those with them (each occluder counted once); 'near':
+# image-space near field within max_distance (rays = samples per pixel); 'near+far': both.
+METHODS = ("hao", "far", "hao+far", "near", "near+far")
 
 
 @dataclass(frozen=True)

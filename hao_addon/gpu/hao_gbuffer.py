@@ -10,8 +10,8 @@ from . import util
 from .shaders import cached_shader, glsl_source
 
 
-def _gbuffer_info() -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo("hao_gbuffer_iface")
+def _gbuffer_info(back_layer: bool) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_gbuffer_iface_{int(back_layer)}")
     iface.smooth('VEC3', "world_pos")
     iface.smooth('VEC3', "world_nrm")
     iface.flat('FLOAT', "receiver")
@@ -23,20 +23,25 @@ def _gbuffer_info() -> "gpu.types.GPUShaderCreateInfo":
     info.push_constant('MAT4', "view_proj")
     info.fragment_out(0, 'VEC4', "gbuf_position")
     info.fragment_out(1, 'VEC4', "gbuf_normal")
+    if back_layer:
+        info.define("BACK_LAYER", "1")
     info.vertex_source(glsl_source("hao_gbuffer.vert"))
     info.fragment_source(glsl_source("hao_gbuffer.frag"))
     return info
 
 
-def gbuffer_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("hao_gbuffer",), _gbuffer_info)
+def gbuffer_shader(back_layer: bool = False) -> "gpu.types.GPUShader":
+    return cached_shader(("hao_gbuffer", back_layer), lambda: _gbuffer_info(back_layer))
 
 
 class GBufferPass(util.GPUPass):
-    """Owns the mesh batch and the G-buffer textures (reallocated when the size changes)."""
+    """Owns the mesh batch and the G-buffer textures (reallocated when the size changes).
+    back_layer: the nearest back faces with their own normals (front faces culled), the
+    second layer of the near-field pass."""
 
-    def __init__(self) -> None:
+    def __init__(self, back_layer: bool = False) -> None:
         super().__init__()
+        self.back_layer = back_layer
         self.batch = None
         self.size = (0, 0)
         self.position = self.normal = self.depth = self.fb = None
@@ -64,10 +69,10 @@ class GBufferPass(util.GPUPass):
             gpu.state.viewport_set(0, 0, width, height)
             gpu.state.depth_test_set('LESS')
             gpu.state.depth_mask_set(True)
-            gpu.state.face_culling_set('NONE')
+            gpu.state.face_culling_set('FRONT' if self.back_layer else 'NONE')
             gpu.state.blend_set('NONE')
             if self.batch is not None:
-                shader = gbuffer_shader()
+                shader = gbuffer_shader(self.back_layer)
                 shader.bind()
                 shader.uniform_float("view_proj", np.asarray(view_proj, np.float32).T.ravel())
                 self.batch.draw(shader)

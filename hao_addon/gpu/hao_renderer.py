@@ -27,6 +27,7 @@ from . import util
 from .hao_gbuffer import GBufferPass
 from .hao_sampling import AOSamplingPass, BilateralPass
 from .hao_voxelize import VoxelPass
+from .near_field import run_near_field
 from .sphere_far import FarSpheresPass
 
 
@@ -46,6 +47,7 @@ class HaoRenderer(util.GPUPass):
         self.sampling = AOSamplingPass()
         self.filter = BilateralPass()
         self.far = FarSpheresPass()
+        self.back = GBufferPass(back_layer=True)  # second layer of the near-field pass
         self.stats: Counter = Counter()
         self._keys: dict[str, object] = {}
         self.spec: GridSpec | None = None
@@ -80,6 +82,7 @@ class HaoRenderer(util.GPUPass):
                      else np.zeros(0, bool))
             self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
             self.gbuffer.set_geometry(pos, nrm, flags)
+            self.back.set_geometry(pos, nrm, flags)
             self.stats["upload"] += 1
         bounds = region if region is not None else scene_bounds(objects)
         if bounds is None:
@@ -99,17 +102,27 @@ class HaoRenderer(util.GPUPass):
         if self._changed("view", view_key):
             self.gbuffer.render(view_proj, width, height)
             self.stats["gbuffer"] += 1
-        use_spheres = settings.method in ("far", "hao+far")
+        use_near = settings.method in ("near", "near+far")
+        if use_near and self._changed("back", view_key):
+            self.back.render(view_proj, width, height)
+            self.stats["back_layer"] += 1
+        use_spheres = settings.method in ("far", "hao+far", "near+far")
         if use_spheres and spheres is None:
             raise BakeInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
         sphere_key = ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes(),
                        settings.epsilon) if use_spheres else None)
         ao_key = (settings.method, grid_key if use_voxels else None, view_key, sphere_key, settings.scale,
-                  (settings.rays, settings.steps, settings.spread, settings.max_distance) if use_voxels else None)
+                  (settings.rays, settings.steps, settings.spread, settings.max_distance) if use_voxels or use_near
+                  else None)
         if self._changed("ao", ao_key):
             if use_voxels:
                 self.sampling.run(self.gbuffer, self.voxels, settings)
                 self.stats["ao"] += 1
+            elif use_near:
+                self.sampling.clear(self.gbuffer, settings.scale)
+                run_near_field(self.gbuffer, self.back, self.sampling.ao_low, settings.scale, view_proj,
+                               settings.max_distance, settings.rays)
+                self.stats["near"] += 1
             else:
                 self.sampling.clear(self.gbuffer, settings.scale)
             if use_spheres:
@@ -133,6 +146,6 @@ class HaoRenderer(util.GPUPass):
         return self.sampling.sampled_pixels()
 
     def _release(self) -> None:
-        for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far):
+        for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far, self.back):
             p.free()
         self._keys.clear()
