@@ -2,8 +2,8 @@
  * and 3 (A_psi / pi as a fraction of the cosine-weighted hemisphere), cut off beyond d_far. Multiplicative blending into the AO map: A *= 1 - occlusion. */
 void main()
 {
-  vec4 p;
-  ivec2 pick = pick_gbuffer_pixel(ivec2(gl_FragCoord.xy), p);
+  ivec2 low = ivec2(gl_FragCoord.xy);
+  vec4 p = imageLoad(low_position, low);
   if (p.w < 1.0) {
     discard;
   }
@@ -16,7 +16,7 @@ void main()
   float r = sphere_data.w;
   float occlusion = 1.0;
   if (dist > 0.0) {
-    vec3 n = imageLoad(gbuf_normal, pick).xyz;
+    vec3 n = imageLoad(low_normal, low).xyz;
     float sin_t = min(r / max(dist, r), 1.0);
     float solid_angle = 6.283185307179586 * (1.0 - sqrt(max(1.0 - sin_t * sin_t, 0.0)));
     occlusion = min(solid_angle * max(dot(n, pc) / dist, 0.0) / 3.141592653589793, 1.0);

@@ -108,3 +108,26 @@ def test_near_field_sphere_on_plane_against_analytic(renderer):
     e = ao[ring] - exact
     assert ring.sum() > 300 and exact.min() < 0.7
     assert np.sqrt((e * e).mean()) < 0.05 and abs(e.mean()) < 0.025
+
+
+def test_billboards_bound_the_projected_balls_tightly():
+    from hao_addon.core import camera_math as cm
+    from hao_addon.gpu.sphere_far import billboard_rectangles
+    vp = cm.perspective(0.8, 4 / 3, 0.1, 100.0) @ cm.look_at((0.0, -5.0, 1.0), (0.0, 0.0, 0.5))
+    rng = np.random.default_rng(0)
+    centres = rng.uniform(-1.5, 1.5, (50, 3))
+    reach = rng.uniform(0.05, 0.6, 50)
+    rect, visible = billboard_rectangles(centres, reach, vp)
+    # Points on each sphere project inside its rectangle, and touch all four sides.
+    d = rng.normal(size=(4000, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    for k in range(50):
+        pts = centres[k] + reach[k] * d
+        clip = np.c_[pts, np.ones(len(pts))] @ vp.T
+        ndc = np.clip(clip[:, :2] / clip[:, 3:4], -1.0, 1.0)  # rectangles are clipped to the screen
+        assert (ndc.min(0) >= rect[k, :2] - 1e-9).all() and (ndc.max(0) <= rect[k, 2:] + 1e-9).all()
+        inside = (np.abs(ndc) < 1).all(1)
+        if inside.all():
+            assert np.allclose(ndc.min(0), rect[k, :2], atol=2e-3) and np.allclose(ndc.max(0), rect[k, 2:], atol=2e-3)
+    behind = billboard_rectangles(np.array([[0.0, -5.2, 1.0]]), np.array([0.5]), vp)[0]
+    assert np.allclose(behind, (-1, -1, 1, 1))  # a ball around the camera covers the screen

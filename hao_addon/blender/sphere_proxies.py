@@ -8,19 +8,19 @@ CLUSTER_ATTRIBUTE (cluster of each vertex) and the float point attribute WEIGHT_
 Per frame only objects whose evaluated vertices changed are recomputed (`stats`)."""
 from __future__ import annotations
 
-import hashlib
-
 import bpy
 import numpy as np
 
 from ..core.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
+from .mesh_data import read_positions
 
 CLUSTER_ATTRIBUTE = "hao_sphere_cluster"
 WEIGHT_ATTRIBUTE = "hao_sphere_weight"
 K_PROPERTY = "hao_sphere_count"
 
 stats = {"synced": 0, "reused": 0}
-_cache: dict[str, tuple[str, np.ndarray, np.ndarray]] = {}
+# name -> (evaluated vertices, world matrix, centres, radii) of the last update
+_cache: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def has_armature(obj: bpy.types.Object) -> bool:
@@ -80,32 +80,29 @@ def _read_attribute(mesh, name, dtype) -> np.ndarray:
 
 def object_spheres(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
     """World-space (centres (K, 3), radii (K,)) of the object's proxies in the evaluated pose.
-    Reuses the last result when the evaluated vertices and transform are unchanged."""
+
+    Work per frame: one read of the evaluated vertices (the depsgraph's mesh, no copy), one
+    comparison with the last frame's (memcmp speed), and only when they differ the sphere
+    update, in object space (see core.lloyd.sphere_proxies), then K centres to world space.
+    Radii scale by the largest axis scale of the object (exact for uniform scale)."""
     mesh = obj.data
-    labels = _read_attribute(mesh, CLUSTER_ATTRIBUTE, np.int32)
-    weights = _read_attribute(mesh, WEIGHT_ATTRIBUTE, np.float32).astype(np.float64)
-    k = int(mesh[K_PROPERTY])
     obj_eval = obj.evaluated_get(depsgraph)
-    emesh = obj_eval.to_mesh()
-    try:
-        co = np.empty(len(emesh.vertices) * 3, np.float32)
-        emesh.vertices.foreach_get("co", co)
-    finally:
-        obj_eval.to_mesh_clear()
+    emesh = obj_eval.data
+    co = read_positions(emesh)
     m = np.array(obj_eval.matrix_world, np.float64)
-    h = hashlib.blake2b(co.tobytes(), digest_size=16)
-    h.update(m.tobytes())
-    key = h.hexdigest()
     cached = _cache.get(obj.name)
-    if cached is not None and cached[0] == key:
+    if cached is not None and np.array_equal(cached[0], co) and np.array_equal(cached[1], m):
         stats["reused"] += 1
-        return cached[1], cached[2]
+        return cached[2], cached[3]
+    labels = _read_attribute(mesh, CLUSTER_ATTRIBUTE, np.int32)
     if len(co) // 3 != len(labels):
         raise ProxyError(f"'{obj.name}' now has {len(co) // 3} vertices but its sphere proxies were made for "
                          f"{len(labels)} (a modifier changed the topology): sync the sphere proxies again")
-    world = co.reshape(-1, 3).astype(np.float64) @ m[:3, :3].T + m[:3, 3]
-    centres, radii = sphere_proxies(world, labels, weights, k)
-    _cache[obj.name] = (key, centres, radii)
+    weights = _read_attribute(mesh, WEIGHT_ATTRIBUTE, np.float32)
+    local_centres, local_radii = sphere_proxies(co.reshape(-1, 3), labels, weights, int(mesh[K_PROPERTY]))
+    centres = local_centres @ m[:3, :3].T + m[:3, 3]
+    radii = local_radii * float(np.linalg.norm(m[:3, :3], axis=0).max())
+    _cache[obj.name] = (co, m, centres, radii)
     stats["synced"] += 1
     return centres, radii
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.geometry import boundary_edge_fraction
 from ..core.view_scene import SOLID_BORDER_FRACTION, SceneObject
+from .mesh_data import read_positions
 
 BAKED_AO_PROPERTY = "hao_ao_image"  # set on objects by the Bake AO operator
 
@@ -25,8 +26,7 @@ _CACHE: dict[str, tuple[object, SceneObject]] = {}
 
 
 def _key(obj_eval, mesh) -> str:
-    co = np.empty(len(mesh.vertices) * 3, np.float32)
-    mesh.vertices.foreach_get("co", co)
+    co = read_positions(mesh)
     h = hashlib.blake2b(digest_size=16)
     h.update(np.asarray(obj_eval.matrix_world, np.float32).tobytes())
     h.update(co.tobytes())
@@ -37,8 +37,7 @@ def _key(obj_eval, mesh) -> str:
 def _build(obj_eval, mesh, key: str) -> SceneObject:
     mesh.calc_loop_triangles()
     n_tri = len(mesh.loop_triangles)
-    co = np.empty(len(mesh.vertices) * 3, np.float64)
-    mesh.vertices.foreach_get("co", co)
+    co = read_positions(mesh).astype(np.float64)
     tri_verts = np.empty(n_tri * 3, np.int64)
     mesh.loop_triangles.foreach_get("vertices", tri_verts)
     tri_loops = np.empty(n_tri * 3, np.int64)

@@ -25,7 +25,7 @@ from ..core.view_settings import ViewAOSettings
 from ..core.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
 from . import util
 from .hao_gbuffer import GBufferPass
-from .hao_sampling import AOSamplingPass, BilateralPass
+from .hao_sampling import AOSamplingPass, BilateralPass, LowGBufferPass
 from .hao_voxelize import VoxelPass
 from .near_field import run_near_field
 from .sphere_far import FarSpheresPass
@@ -48,6 +48,7 @@ class HaoRenderer(util.GPUPass):
         self.filter = BilateralPass()
         self.far = FarSpheresPass()
         self.back = GBufferPass(back_layer=True)  # second layer of the near-field pass
+        self.low_gbuffer = LowGBufferPass()  # G-buffer at the AO-map resolution, for the spheres
         self.stats: Counter = Counter()
         self._keys: dict[str, object] = {}
         self.spec: GridSpec | None = None
@@ -126,8 +127,10 @@ class HaoRenderer(util.GPUPass):
             else:
                 self.sampling.clear(self.gbuffer, settings.scale)
             if use_spheres:
-                self.far.run(self.gbuffer, self.sampling.ao_low, settings.scale, spheres[0], spheres[1],
-                             settings.epsilon, view_proj)
+                if self._changed("low_gbuffer", (view_key, settings.scale)):
+                    self.low_gbuffer.run(self.gbuffer, settings.scale)
+                self.far.run(self.low_gbuffer, self.sampling.ao_low, spheres[0], spheres[1], settings.epsilon,
+                             view_proj)
                 self.stats["far"] += 1
         if self._changed("filter", (ao_key, settings.filter_size)):
             self.filter.run(self.gbuffer, self.sampling.ao_low, settings)
@@ -146,6 +149,6 @@ class HaoRenderer(util.GPUPass):
         return self.sampling.sampled_pixels()
 
     def _release(self) -> None:
-        for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far, self.back):
+        for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far, self.back, self.low_gbuffer):
             p.free()
         self._keys.clear()

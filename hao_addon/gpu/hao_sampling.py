@@ -50,6 +50,50 @@ def _bilateral_info(axis: int, upsample: bool) -> "gpu.types.GPUShaderCreateInfo
     return info
 
 
+def _pick_low_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.local_group_size(GROUP, GROUP, 1)
+    info.push_constant('IVEC2', "full_size")
+    info.push_constant('INT', "scale")
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    info.image(2, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'WRITE'})
+    info.image(3, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'WRITE'})
+    info.compute_source(glsl_source("hao_pick.glsl", "hao_pick_low.comp"))
+    return info
+
+
+class LowGBufferPass(util.GPUPass):
+    """The G-buffer at the AO-map resolution (see hao_pick_low.comp)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.position = self.normal = None
+        self.size = (0, 0)
+
+    def run(self, gbuffer, scale: int) -> None:
+        width, height = gbuffer.size
+        low = (-(-width // scale), -(-height // scale))
+        if self.size != low:
+            self.position = gpu.types.GPUTexture(low, format='RGBA32F')
+            self.normal = gpu.types.GPUTexture(low, format='RGBA32F')
+            self.size = low
+        shader = cached_shader(("hao_pick_low",), _pick_low_info)
+        shader.bind()
+        shader.uniform_int("full_size", (width, height))
+        shader.uniform_int("scale", scale)
+        shader.image("gbuf_position", gbuffer.position)
+        shader.image("gbuf_normal", gbuffer.normal)
+        shader.image("low_position", self.position)
+        shader.image("low_normal", self.normal)
+        gpu.compute.dispatch(shader, -(-low[0] // GROUP), -(-low[1] // GROUP), 1)
+        gpu.shader.unbind()
+
+    def _release(self) -> None:
+        self.position = self.normal = None
+        self.size = (0, 0)
+
+
 def ao_shader() -> "gpu.types.GPUShader":
     return cached_shader(("hao_ao",), _ao_info)
 

@@ -25,13 +25,11 @@ def _far_info() -> "gpu.types.GPUShaderCreateInfo":
     info.vertex_in(1, 'VEC4', "sphere")
     info.vertex_in(2, 'FLOAT', "reach")
     info.vertex_out(iface)
-    info.push_constant('IVEC2', "full_size")
-    info.push_constant('INT', "scale")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
-    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'READ'})
     info.fragment_out(0, 'VEC4', "far_out")
     info.vertex_source(glsl_source("sphere_far.vert"))
-    info.fragment_source(glsl_source("hao_pick.glsl", "sphere_far.frag"))
+    info.fragment_source(glsl_source("sphere_far.frag"))
     return info
 
 
@@ -40,17 +38,34 @@ def far_shader() -> "gpu.types.GPUShader":
 
 
 def billboard_rectangles(centres: np.ndarray, reach: np.ndarray, view_proj: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """NDC rectangles (K, 4) = (x0, y0, x1, y1) conservatively covering the projection of each
-    ball (centre, reach), and a (K,) mask of those that touch the screen. A ball reaching
-    behind the camera plane covers the whole screen."""
-    offsets = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], np.float64)
-    corners = centres[:, None, :] + reach[:, None, None] * offsets[None]  # the cube around the ball
-    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], axis=2) @ np.asarray(view_proj, np.float64).T
-    w = clip[..., 3]
-    behind = (w <= 1e-9).any(axis=1)
-    ndc = clip[..., :2] / np.where(w > 1e-9, w, 1.0)[..., None]
-    rect = np.concatenate([ndc.min(axis=1), ndc.max(axis=1)], axis=1)
-    rect[behind] = (-1.0, -1.0, 1.0, 1.0)
+    """NDC rectangles (K, 4) = (x0, y0, x1, y1), the exact bounds of the projection of each
+    ball (centre, reach), and a (K,) mask of those that touch the screen.
+
+    A screen line x_ndc = s is the plane (row0 - s row3) . X = 0; it touches the ball when its
+    distance from the centre equals the radius, a quadratic in s whose roots bound the ball
+    (perspective or orthographic alike). A ball reaching behind the camera plane (leading
+    coefficient <= 0) covers the whole screen."""
+    m = np.asarray(view_proj, np.float64)
+    c = np.concatenate([np.asarray(centres, np.float64), np.ones((len(centres), 1))], axis=1)
+    r2 = np.asarray(reach, np.float64) ** 2
+    b = c @ m[3]
+    v = m[3, :3]
+    rect = np.empty((len(c), 4))
+    whole = np.zeros(len(c), bool)
+    for axis in (0, 1):
+        a = c @ m[axis]
+        u = m[axis, :3]
+        qa = b * b - r2 * (v @ v)
+        qb = -2.0 * (a * b - r2 * (u @ v))
+        qc = a * a - r2 * (u @ u)
+        disc = np.maximum(qb * qb - 4.0 * qa * qc, 0.0)
+        ok = qa > 1e-12
+        root = np.sqrt(disc)
+        safe = np.where(ok, qa, 1.0)
+        lo, hi = (-qb - root) / (2.0 * safe), (-qb + root) / (2.0 * safe)
+        rect[:, axis], rect[:, axis + 2] = np.minimum(lo, hi), np.maximum(lo, hi)
+        whole |= ~ok
+    rect[whole] = (-1.0, -1.0, 1.0, 1.0)
     rect = np.clip(rect, -1.0, 1.0)
     visible = (rect[:, 2] > rect[:, 0]) & (rect[:, 3] > rect[:, 1])
     return rect, visible
@@ -63,10 +78,11 @@ class FarSpheresPass(util.GPUPass):
         super().__init__()
         self.stats = dict(spheres_drawn=0, spheres_culled=0)
 
-    def run(self, gbuffer, ao_map, scale: int, centres: np.ndarray, radii: np.ndarray, epsilon: float,
+    def run(self, low_gbuffer, ao_map, centres: np.ndarray, radii: np.ndarray, epsilon: float,
             view_proj: np.ndarray) -> None:
-        """ao_map: R32F texture of ceil(size / scale), already holding an accessibility (1s for
-        spheres alone, or the HAO result to combine with)."""
+        """low_gbuffer: the G-buffer at the AO-map resolution (LowGBufferPass); ao_map: R32F
+        texture of that size, already holding an accessibility (1s for spheres alone, or the
+        HAO result to combine with)."""
         centres = np.asarray(centres, np.float64).reshape(-1, 3)
         radii = np.asarray(radii, np.float64).reshape(-1)
         reach = far_distance(radii, epsilon)
@@ -81,14 +97,11 @@ class FarSpheresPass(util.GPUPass):
         sphere = np.repeat(np.concatenate([centres[keep], radii[keep, None]], axis=1), 6, axis=0)
         batch = util.make_batch('TRIS', {"corner": ('F32', corners), "sphere": ('F32', sphere),
                                          "reach": ('F32', np.repeat(reach[keep], 6))})
-        width, height = gbuffer.size
         fb = gpu.types.GPUFrameBuffer(color_slots=ao_map)
         with util.scoped_state(), fb.bind():
             util.set_overlay_pass_state(ao_map.width, ao_map.height, blend='MULTIPLY')
             shader = far_shader()
             shader.bind()
-            shader.uniform_int("full_size", (width, height))
-            shader.uniform_int("scale", scale)
-            shader.image("gbuf_position", gbuffer.position)
-            shader.image("gbuf_normal", gbuffer.normal)
+            shader.image("low_position", low_gbuffer.position)
+            shader.image("low_normal", low_gbuffer.normal)
             batch.draw(shader)
