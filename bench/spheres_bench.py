@@ -243,7 +243,7 @@ def main() -> int:
 
     print("off-screen occluder (wall behind the camera):", flush=True)
     floor = scenes.grid_plane(4.0, 8, name="floor")
-    wall = scenes.wall(4.0, 1.5, 0.0)
+    wall = scenes.box((0.0, -2.0, 0.0), (0.1, 2.0, 1.5), name="wall")  # a 10 cm thick wall
     objs = [object_from_soup(floor, "floor"), object_from_soup(wall, "wall")]
     vp_wall = cm.perspective(0.9, WIDTH / HEIGHT, 0.05, 50.0) @ cm.look_at((-0.05, 0.0, 1.2), (-0.8, 0.0, 0.0))
     res["offscreen"] = method_errors(renderer, objs, None, vp_wall, ("hao", "near"), points, rays, 1,

@@ -191,3 +191,4 @@ def test_closed_surface_detection():
     assert not is_closed_surface(np.concatenate([torus, torus[:1]]))  # a duplicated face (fin)
     assert not is_closed_surface(scenes.grid_plane(2.0, 4).positions)  # open sheet
     assert not is_closed_surface(np.zeros((0, 3, 3)))
+    assert is_closed_surface(scenes.box((0, 0, 0), (1, 2, 3)).positions)

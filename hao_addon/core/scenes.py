@@ -80,6 +80,22 @@ def torus(major: float, minor: float, centre, segments: int = 48, sides: int = 2
     return TriangleSoup(pos + np.asarray(centre, float), uv, name=name)
 
 
+def box(lo, hi, name: str = "box") -> TriangleSoup:
+    """Closed axis-aligned box [lo, hi] (outward normals, counter-clockwise, welded corners),
+    each face mapped onto the whole UV square."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    corner = lambda i: np.where([(i >> a) & 1 for a in range(3)], hi, lo)  # noqa: E731
+    # Each face: four corner indices (bit a = upper on axis a), counter-clockwise from outside.
+    faces = [(0, 4, 6, 2), (1, 3, 7, 5), (0, 1, 5, 4), (2, 6, 7, 3), (0, 2, 3, 1), (4, 5, 7, 6)]
+    tris, uvs = [], []
+    square = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    for f in faces:
+        for a, b, c in ((0, 1, 2), (0, 2, 3)):
+            tris.append([corner(f[a]), corner(f[b]), corner(f[c])])
+            uvs.append([square[a], square[b], square[c]])
+    return TriangleSoup(np.array(tris), np.array(uvs, float), name=name)
+
+
 def wall(width: float, height: float, x: float, name: str = "wall") -> TriangleSoup:
     """Vertical rectangle in the plane x = const, facing -x (towards the floor at x < wall),
     spanning y in [-width/2, width/2], z in [0, height]."""
