@@ -93,6 +93,22 @@ def draw_spheres() -> None:
     batch.draw(shader)
 
 
+@bpy.app.handlers.persistent
+def sync_on_frame_change(scene, depsgraph=None) -> None:
+    """Per-frame sync: update the proxies of visible meshes whose deformation changed (the
+    others are reused, see hao_addon/blender/sphere_proxies.py). Errors (a topology change)
+    are left to the passes that use the spheres, which report them."""
+    from ..hao_addon.blender.sphere_proxies import scene_spheres
+    from ..hao_addon.core.lloyd import ProxyError
+    view_layer = bpy.context.view_layer
+    if view_layer is None:
+        return
+    try:
+        scene_spheres(view_layer, depsgraph or bpy.context.evaluated_depsgraph_get())
+    except ProxyError:
+        pass
+
+
 classes = (OBJECT_OT_hao_sync_spheres, OBJECT_OT_hao_clear_spheres)
 
 
@@ -101,10 +117,13 @@ def register() -> None:
     for cls in classes:
         bpy.utils.register_class(cls)
     _draw_handle = bpy.types.SpaceView3D.draw_handler_add(draw_spheres, (), 'WINDOW', 'POST_VIEW')
+    bpy.app.handlers.frame_change_post.append(sync_on_frame_change)
 
 
 def unregister() -> None:
     global _draw_handle
+    while sync_on_frame_change in bpy.app.handlers.frame_change_post:
+        bpy.app.handlers.frame_change_post.remove(sync_on_frame_change)
     if _draw_handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_draw_handle, 'WINDOW')
         _draw_handle = None

@@ -48,9 +48,14 @@ def test_sync_operator_spheres_follow_the_walk(addon, gpu_context):
     from hao_ext.hao_addon.blender import sphere_proxies as sp
     man = _load_character()
     bpy.context.view_layer.objects.active = man
-    assert bpy.ops.object.hao_sync_spheres(count=32) == {'FINISHED'}
+    assert bpy.ops.object.hao_sync_spheres(count=32, seed=0, max_iterations=60) == {"FINISHED"}
+    assert dict(man[sp.SETTINGS_PROPERTY]) == {"count": 32, "seed": 0, "max_iterations": 60}
     attr = man.data.attributes[sp.CLUSTER_ATTRIBUTE]
     assert attr.data_type == 'INT' and attr.domain == 'POINT' and man.data[sp.K_PROPERTY] == 32
+    # The frame-change handler keeps the spheres current: after frame_set they are cached.
+    synced = sp.stats["synced"]
+    bpy.context.scene.frame_set(7)
+    assert sp.stats["synced"] == synced + 1 and man.name in sp._cache
     labels = _labels(man)
     worst = 0.0
     for frame in range(1, 49, 4):
@@ -65,28 +70,25 @@ def test_sync_operator_spheres_follow_the_walk(addon, gpu_context):
 
 
 def test_only_changed_deformations_are_resynced(addon, gpu_context):
+    """The frame-change handler updates a character's spheres when the walk moved its skin and
+    re-uses them otherwise; without animation frame changes cost no update at all."""
     from hao_ext.hao_addon.blender import sphere_proxies as sp
     man = _load_character()
     sp.make_proxies(man, 24)
-    bpy.context.scene.frame_set(5)
-    dg = bpy.context.evaluated_depsgraph_get()
     before = dict(sp.stats)
-    first = sp.object_spheres(man, dg)
-    again = sp.object_spheres(man, dg)  # same frame: nothing moved
+    bpy.context.scene.frame_set(5)  # the handler syncs
+    assert sp.stats["synced"] == before["synced"] + 1
+    first = sp.object_spheres(man, bpy.context.evaluated_depsgraph_get())  # same frame: re-used
     assert sp.stats["synced"] == before["synced"] + 1 and sp.stats["reused"] == before["reused"] + 1
-    assert again[0] is first[0]
-    bpy.context.scene.frame_set(9)
-    sp.object_spheres(man, bpy.context.evaluated_depsgraph_get())
-    assert sp.stats["synced"] == before["synced"] + 2  # the walk moved the skin
-    # Without its animation the character is static: frame changes re-use the spheres.
-    bpy.data.objects["Armature"].animation_data_clear()
+    assert first[0] is sp._cache[man.name][2]
+    bpy.context.scene.frame_set(9)  # the walk moved the skin
+    assert sp.stats["synced"] == before["synced"] + 2
+    bpy.data.objects["Armature"].animation_data_clear()  # now static
     bpy.context.scene.frame_set(12)
-    sp.object_spheres(man, bpy.context.evaluated_depsgraph_get())
     synced = sp.stats["synced"]
     for frame in (13, 20, 30):
         bpy.context.scene.frame_set(frame)
-        sp.object_spheres(man, bpy.context.evaluated_depsgraph_get())
-    assert sp.stats["synced"] == synced
+    assert sp.stats["synced"] == synced and sp.stats["reused"] >= before["reused"] + 4
 
 
 def test_bad_input_messages(addon, gpu_context):

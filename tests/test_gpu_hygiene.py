@@ -70,7 +70,8 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
     assert not HAO_PG_bake_settings.is_registered
     assert cli_command._handle is None and viewport_overlay._draw_handle is None
     assert sphere_operators._draw_handle is None
-    assert [len(h) for h in handler_lists] == [c - 1 for c in counts]
+    assert sphere_operators.sync_on_frame_change not in bpy.app.handlers.frame_change_post
+    assert [len(h) for h in handler_lists] == [counts[0] - 1, counts[1] - 2, counts[2] - 1]
     addon.register()
     assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
     assert [len(h) for h in handler_lists] == counts

@@ -17,6 +17,7 @@ from .mesh_data import read_positions
 CLUSTER_ATTRIBUTE = "hao_sphere_cluster"
 WEIGHT_ATTRIBUTE = "hao_sphere_weight"
 K_PROPERTY = "hao_sphere_count"
+SETTINGS_PROPERTY = "hao_sphere_settings"  # on the object: what the last sync used
 
 stats = {"synced": 0, "reused": 0}
 # name -> (evaluated vertices, world matrix, centres, radii) of the last update
@@ -58,6 +59,7 @@ def make_proxies(obj: bpy.types.Object, count: int, seed: int = 0, max_iteration
         attr = mesh.attributes.new(name, kind, 'POINT')
         attr.data.foreach_set("value", values)
     mesh[K_PROPERTY] = int(count)
+    obj[SETTINGS_PROPERTY] = {"count": int(count), "seed": int(seed), "max_iterations": int(max_iterations)}
     _cache.pop(obj.name, None)
     return dict(iterations=clustering.iterations, converged=clustering.converged, energy=clustering.energies[-1])
 
@@ -69,6 +71,8 @@ def clear_proxies(obj: bpy.types.Object) -> None:
             mesh.attributes.remove(mesh.attributes[name])
     if K_PROPERTY in mesh:
         del mesh[K_PROPERTY]
+    if SETTINGS_PROPERTY in obj:
+        del obj[SETTINGS_PROPERTY]
     _cache.pop(obj.name, None)
 
 
