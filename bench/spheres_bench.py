@@ -96,7 +96,7 @@ def sync_blender(k=128):
         arm.pose.bones[0].rotation_euler = (angle, 0.0, 0.0)
         arm.pose.bones[0].keyframe_insert("rotation_euler", frame=f)
     sp.make_proxies(body, k)
-    times, reused = [], []
+    times = []
     for frame in range(2, 40):
         bpy.context.scene.frame_set(frame)
         dg = bpy.context.evaluated_depsgraph_get()

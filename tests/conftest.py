@@ -25,6 +25,15 @@ def gpu_context():
     return True
 
 
+@pytest.fixture
+def renderer(gpu_context):
+    """A fresh HaoRenderer (viewport AO passes), freed after the test."""
+    from hao_addon.gpu.hao_renderer import HaoRenderer
+    r = HaoRenderer()
+    yield r
+    r.free()
+
+
 @pytest.fixture(scope="session")
 def addon():
     """The repository root loaded as an add-on package ('hao_ext') and registered, the way

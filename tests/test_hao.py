@@ -37,14 +37,6 @@ def view(eye, target=(0.0, 0.0, 0.3), width=160, height=120, fov=0.9):
     return cm.perspective(fov, width / height, 0.05, 100.0) @ cm.look_at(eye, target), width, height
 
 
-@pytest.fixture
-def renderer(gpu_context):
-    from hao_addon.gpu.hao_renderer import HaoRenderer
-    r = HaoRenderer()
-    yield r
-    r.free()
-
-
 def low_res_samples(renderer, settings):
     """World positions/normals of the G-buffer pixels the AO pass sampled, the AO there, and
     the mask of sampled (covered) AO-map pixels."""

@@ -8,7 +8,6 @@ import sys
 
 import bpy
 import numpy as np
-import pytest
 
 from conftest import ROOT
 from hao_addon.core import camera_math as cm
@@ -25,14 +24,6 @@ def _scene_objects():
     sphere = scenes.uv_sphere(0.5, (0.0, 0.0, 0.5), 32, 16, name="sphere")
     plane = scenes.grid_plane(6.0, 6, name="plane")
     return [object_from_soup(plane, "plane"), object_from_soup(sphere, "sphere")]
-
-
-@pytest.fixture
-def renderer(gpu_context):
-    from hao_addon.gpu.hao_renderer import HaoRenderer
-    r = HaoRenderer()
-    yield r
-    r.free()
 
 
 def test_each_pass_runs_only_when_its_inputs_change(renderer):

@@ -4,7 +4,6 @@ rule against ray-traced ground truth."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from hao_addon.core import scenes
 from hao_addon.core.reference import reference_accessibility
@@ -22,14 +21,6 @@ def _scene():
     balls = [scenes.uv_sphere(r, c, 48, 24, name=f"ball{i}") for i, (c, r) in enumerate(zip(CENTRES, RADII))]
     objs = [object_from_soup(floor, "floor")] + [object_from_soup(b, b.name) for b in balls]
     return objs, [floor] + balls
-
-
-@pytest.fixture
-def renderer(gpu_context):
-    from hao_addon.gpu.hao_renderer import HaoRenderer
-    r = HaoRenderer()
-    yield r
-    r.free()
 
 
 def test_far_pass_equals_numpy_reference(renderer):

@@ -70,6 +70,18 @@ def stratified_cosine_hemisphere(count: int, rng: np.random.Generator) -> np.nda
     return np.stack([x, y, z], axis=1)
 
 
+def malley_quadrature(samples: int) -> np.ndarray:
+    """(samples^2, 3) local directions (z up) of a samples x samples midpoint rule on Malley's
+    disk: equal-weight, cosine-distributed quadrature nodes of the hemisphere (their mean of
+    any f approximates (1/pi) int f cos d omega)."""
+    k = (np.arange(samples) + 0.5) / samples
+    r = np.sqrt(k)[:, None]
+    phi = 2.0 * np.pi * k[None, :]
+    shape = (samples, samples)
+    return np.stack([np.broadcast_to(r * np.cos(phi), shape), np.broadcast_to(r * np.sin(phi), shape),
+                     np.broadcast_to(np.sqrt(1.0 - r * r), shape)], -1).reshape(-1, 3)
+
+
 def frame_from_normal(n: np.ndarray) -> np.ndarray:
     """Orthonormal frames (m, 3, 3) whose third row is the unit normal n (m, 3).
 

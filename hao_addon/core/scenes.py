@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .directions import malley_quadrature
 from .geometry import TriangleSoup
 from .kernels import occlusion_weight
 
@@ -163,12 +164,7 @@ def sphere_on_plane_kernel_accessibility(rho: np.ndarray, radius: float, max_dis
     exact ray-sphere distance t and a quadrature x quadrature midpoint rule on Malley's disk
     (cosine-weighted). With w = 1 (max_distance -> inf) it reduces to 1 - (R/D)^3."""
     rho = np.atleast_1d(np.asarray(rho, np.float64))
-    k = (np.arange(quadrature) + 0.5) / quadrature
-    r = np.sqrt(k)[:, None]
-    phi = 2.0 * np.pi * k[None, :]
-    d = np.stack([np.broadcast_to(r * np.cos(phi), (quadrature, quadrature)),
-                  np.broadcast_to(r * np.sin(phi), (quadrature, quadrature)),
-                  np.broadcast_to(np.sqrt(1.0 - r * r), (quadrature, quadrature))], -1).reshape(-1, 3)
+    d = malley_quadrature(quadrature)
     out = np.empty(len(rho))
     for i, x in enumerate(rho):
         oc = np.array([x, 0.0, -radius])  # origin minus sphere centre (centre at (0, 0, R))

@@ -71,12 +71,8 @@ def sphere_occlusion_quadrature(points: np.ndarray, normals: np.ndarray, centre:
     """Exact cosine-weighted occluded fraction of one sphere (horizon clipping included) by a
     samples x samples midpoint rule on Malley's disk, for testing sphere_occlusion."""
     from .ao_pattern import tangent_frames
-    k = (np.arange(samples) + 0.5) / samples
-    r = np.sqrt(k)[:, None]
-    phi = 2.0 * np.pi * k[None, :]
-    local = np.stack([np.broadcast_to(r * np.cos(phi), (samples, samples)),
-                      np.broadcast_to(r * np.sin(phi), (samples, samples)),
-                      np.broadcast_to(np.sqrt(1.0 - r * r), (samples, samples))], -1).reshape(-1, 3)
+    from .directions import malley_quadrature
+    local = malley_quadrature(samples)
     normals = np.asarray(normals, np.float64)
     t, s = tangent_frames(normals)
     out = np.empty(len(points))
