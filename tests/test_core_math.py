@@ -192,3 +192,17 @@ def test_closed_surface_detection():
     assert not is_closed_surface(scenes.grid_plane(2.0, 4).positions)  # open sheet
     assert not is_closed_surface(np.zeros((0, 3, 3)))
     assert is_closed_surface(scenes.box((0, 0, 0), (1, 2, 3)).positions)
+
+
+def test_written_files_get_normal_permissions_and_rgba_png_header(tmp_path):
+    import os
+    from hao_addon.core.imageio import write_ao_file
+    umask = os.umask(0)
+    os.umask(umask)
+    for name, img in (("gray.png", np.full((2, 3), 0.5)), ("rgba.png", np.full((2, 3, 4), 0.25)),
+                      ("rgba.exr", np.full((2, 3, 4), 0.25))):
+        write_ao_file(tmp_path / name, img)
+        assert (tmp_path / name).stat().st_mode & 0o777 == 0o666 & ~umask, name
+    data = (tmp_path / "rgba.png").read_bytes()
+    assert struct.unpack(">IIBB", data[16:26]) == (3, 2, 16, 6)  # 16-bit RGBA
+    assert not list(tmp_path.glob("*.part"))
