@@ -178,7 +178,7 @@ def method_errors(renderer, objects, spheres, vp, methods, points, rays, seed, r
     rng = np.random.default_rng(seed)
     pick = rng.choice(len(ys), min(points, len(ys)), replace=False)
     ys, xs = ys[pick], xs[pick]
-    tris = np.concatenate([o.positions for o in objects]).astype(np.float64)
+    tris = np.concatenate([o.world_positions() for o in objects])
     ref = reference_accessibility(pos[ys, xs, :3].astype(np.float64), nrm[ys, xs, :3].astype(np.float64), tris,
                                   rays=rays, max_distance=max_distance, falloff="wendland", seed=seed,
                                   bvh=build_bvh(tris))

@@ -138,7 +138,7 @@ def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
             spheres, proxied = sp.scene_spheres(bpy.context.view_layer, dg)
             for o in objects:
                 o.proxied = o.name in proxied
-            tris = np.concatenate([o.positions for o in objects]).astype(np.float64)
+            tris = np.concatenate([o.world_positions() for o in objects])
             for method in ("hao", "far", "hao+far"):
                 settings = ViewAOSettings(method=method, rays=64, steps=16, max_distance=0.3, grid=256, filter_size=0)
                 renderer.render(objects, vp, w, h, settings, spheres=spheres)

@@ -3,6 +3,7 @@
 the render-ao command line and the overlay's registration."""
 from __future__ import annotations
 
+import dataclasses
 import subprocess
 import sys
 
@@ -43,7 +44,7 @@ def test_each_pass_runs_only_when_its_inputs_change(renderer):
     renderer.render(objs, vp2, w, h, settings.with_(filter_size=4, rays=16))  # sampling setting
     assert runs() == dict(upload=1, voxelize=1, gbuffer=2, ao=3, filter=4)
     moved = objs[1]
-    moved = type(moved)(moved.name, "moved", moved.positions + np.float32(0.1), moved.normals, 1.0, True)
+    moved = dataclasses.replace(moved, key="moved", offset=moved.offset + 0.1)
     renderer.render([objs[0], moved], vp2, w, h, settings.with_(filter_size=4, rays=16))  # geometry changed
     assert runs() == dict(upload=2, voxelize=2, gbuffer=3, ao=4, filter=5)
     renderer.render([objs[0], moved], vp2, w, h, settings.with_(filter_size=4, rays=16, grid=96))  # grid only
@@ -55,7 +56,7 @@ def test_each_pass_runs_only_when_its_inputs_change(renderer):
     renderer.render([objs[0], moved, far], vp2, w, h, s2, region)
     base = runs()
     far.key = "far-b"
-    far.positions = far.positions + np.float32(0.05)
+    far.offset = far.offset + 0.05
     renderer.render([objs[0], moved, far], vp2, w, h, s2, region)
     assert runs()["upload"] == base["upload"] + 1 and runs()["gbuffer"] == base["gbuffer"] + 1
     assert runs()["voxelize"] == base["voxelize"]
@@ -74,7 +75,7 @@ def test_background_baked_and_out_of_region_pixels_are_not_sampled(renderer):
     ao = renderer.read_ao()
     assert (ao[pos[..., 3] == 0.0] == 1.0).all()
     # The sphere carries a baked map: it still occludes (the floor stays dark) but is not sampled.
-    baked = [objs[0], type(objs[1])(objs[1].name, objs[1].key, objs[1].positions, objs[1].normals, 0.5, True)]
+    baked = [objs[0], dataclasses.replace(objs[1], receiver=0.5)]
     renderer.render(baked, vp, w, h, settings)
     pos_b, _, _ = renderer.gbuffer.read()
     plane_blocks = (pos_b[..., 3] >= 1.0).reshape(h // 2, 2, w // 2, 2).any(axis=(1, 3))
@@ -142,8 +143,8 @@ def test_scene_objects_are_evaluated_and_cached(addon, gpu_context):
     moved = {o.name: o for o in visible_scene_objects(dg, bpy.context.view_layer)}
     assert moved[sphere.name].key != objs[sphere.name].key
     assert moved["Plane"] is objs["Plane"]
-    assert np.isclose(moved[sphere.name].positions[..., 2].min() - objs[sphere.name].positions[..., 2].min(), 0.25,
-                      atol=1e-5)
+    assert np.isclose(moved[sphere.name].world_positions()[..., 2].min()
+                      - objs[sphere.name].world_positions()[..., 2].min(), 0.25, atol=1e-5)
 
 
 def _run_cli(*args):
@@ -222,7 +223,7 @@ def test_composite_darkens_by_ao_and_respects_depth(renderer):
     # "Blender's" depth buffer: the same meshes drawn again (so the surfaces are front-most),
     # or a depth buffer cleared to 0 (something nearer everywhere).
     viewport = GBufferPass()
-    viewport.set_geometry(np.concatenate([o.positions for o in objs]), np.concatenate([o.normals for o in objs]),
+    viewport.set_geometry(np.concatenate([o.world_positions() for o in objs]).astype(np.float32), np.concatenate([o.normals for o in objs]),
                           np.ones(sum(len(o.positions) for o in objs), np.float32))
     viewport.render(vp, w, h)
     nearer_depth = gpu.types.GPUTexture((w, h), format='DEPTH_COMPONENT32F')

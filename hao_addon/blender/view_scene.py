@@ -51,8 +51,9 @@ def _build(obj_eval, mesh, key: str) -> SceneObject:
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     positions = world[tri_verts].reshape(-1, 3, 3)
     solid = boundary_edge_fraction(positions) <= SOLID_BORDER_FRACTION if n_tri else False
-    return SceneObject(obj_eval.name, key, positions.astype(np.float32),
-                       normals.reshape(-1, 3, 3).astype(np.float32), 1.0, bool(solid))
+    offset = 0.5 * (world.min(0) + world.max(0)) if len(world) else np.zeros(3)
+    return SceneObject(obj_eval.name, key, (positions - offset).astype(np.float32),
+                       normals.reshape(-1, 3, 3).astype(np.float32), 1.0, bool(solid), offset=offset)
 
 
 def visible_scene_objects(depsgraph: bpy.types.Depsgraph, view_layer: bpy.types.ViewLayer,

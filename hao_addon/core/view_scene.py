@@ -3,7 +3,7 @@
 (pure numpy; filled from Blender by hao_addon/blender/view_scene.py or from soups in tests)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -16,7 +16,9 @@ SOLID_BORDER_FRACTION = 0.01
 
 @dataclass
 class SceneObject:
-    """positions, normals: (F, 3, 3) float32 world corners and corner normals.
+    """positions, normals: (F, 3, 3) float32 corners relative to `offset` (float64 world, the
+    object's box centre, so that float32 keeps its precision far from the origin) and
+    world corner normals.
     key: anything hashable that changes whenever the geometry or transform does.
     receiver: 1.0 gets AO; 0.5 has a baked AO map (skipped by HAO, still occludes).
     solid: also voxelized by parity (closed or nearly closed).
@@ -28,20 +30,41 @@ class SceneObject:
     receiver: float = 1.0
     solid: bool = False
     proxied: bool = False
+    offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def world_positions(self) -> np.ndarray:
+        """(F, 3, 3) float64 world corners."""
+        return self.positions.astype(np.float64) + self.offset
+
+    def world_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        flat = self.positions.reshape(-1, 3)
+        return flat.min(0) + self.offset, flat.max(0) + self.offset
 
 
 def object_from_soup(soup: TriangleSoup, key: object = 0, receiver: float = 1.0) -> SceneObject:
     """Flat-shaded SceneObject of a soup (face normals at every corner)."""
     normals, _ = face_normals_areas(soup.positions)
-    return SceneObject(soup.name, key, soup.positions.astype(np.float32),
+    flat = soup.positions.reshape(-1, 3)
+    offset = 0.5 * (flat.min(0) + flat.max(0))
+    return SceneObject(soup.name, key, (soup.positions - offset).astype(np.float32),
                        np.repeat(normals[:, None], 3, axis=1).astype(np.float32), receiver,
-                       boundary_edge_fraction(soup.positions) <= SOLID_BORDER_FRACTION)
+                       boundary_edge_fraction(soup.positions) <= SOLID_BORDER_FRACTION, offset=offset)
 
 
 def scene_bounds(objects: list[SceneObject]) -> tuple[np.ndarray, np.ndarray] | None:
     """World box (lo, hi) of all triangles, None when there are none."""
-    parts = [o.positions.reshape(-1, 3) for o in objects if len(o.positions)]
-    if not parts:
+    boxes = [o.world_bounds() for o in objects if len(o.positions)]
+    if not boxes:
         return None
-    return (np.min([p.min(0) for p in parts], axis=0).astype(np.float64),
-            np.max([p.max(0) for p in parts], axis=0).astype(np.float64))
+    return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+
+
+def render_anchor(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """A world point the GPU passes measure from, so float32 keeps its precision in scenes
+    far from the origin: the box centre rounded to a multiple of the power of two above the
+    box size (0 for anything that reaches its own size from the origin; stable while
+    objects move within the box, so the object-space noise does not jump)."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    extent = float(np.max(hi - lo))
+    q = 2.0 ** np.ceil(np.log2(max(extent, 1e-9)))
+    return np.round(0.5 * (lo + hi) / q) * q

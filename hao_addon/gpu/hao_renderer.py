@@ -20,7 +20,7 @@ import gpu
 import numpy as np
 
 from ..core.plan import BakeInputError
-from ..core.view_scene import SceneObject, scene_bounds
+from ..core.view_scene import SceneObject, render_anchor, scene_bounds
 from ..core.view_settings import ViewAOSettings
 from ..core.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
 from . import util
@@ -31,12 +31,9 @@ from .near_field import run_near_field
 from .sphere_far import FarSpheresPass
 
 
-def _box_overlaps(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
-    """Whether the bounding box of (F, 3, 3) triangles overlaps the box [lo, hi]."""
-    if len(positions) == 0:
-        return False
-    flat = positions.reshape(-1, 3)
-    return bool((flat.min(0) <= hi).all() and (flat.max(0) >= lo).all())
+def _boxes_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether the boxes [lo_a, hi_a] and [lo, hi] overlap."""
+    return bool((lo_a <= hi).all() and (hi_a >= lo).all())
 
 
 class HaoRenderer(util.GPUPass):
@@ -52,6 +49,7 @@ class HaoRenderer(util.GPUPass):
         self.stats: Counter = Counter()
         self._keys: dict[str, object] = {}
         self.spec: GridSpec | None = None
+        self.anchor = np.zeros(3)  # world point the GPU passes' positions are relative to
 
     def _changed(self, name: str, key: object) -> bool:
         if self._keys.get(name) == key:
@@ -72,33 +70,50 @@ class HaoRenderer(util.GPUPass):
         # With 'hao+far' the spheres stand in for the objects that have them: those are drawn
         # and receive AO but are not voxelized, so no occluder is counted twice.
         voxelized = [o for o in objects if not (settings.method == "hao+far" and o.proxied)]
+        world_bounds = scene_bounds(objects)
+        bounds = region if region is not None else world_bounds
+        if bounds is None:
+            raise BakeInputError("nothing to render: no visible mesh objects")
+        # Everything on the GPU is measured from the anchor (float32 precision far from the
+        # origin); G-buffer positions read back are relative to it (self.anchor).
+        anchor = render_anchor(*(world_bounds if world_bounds is not None else bounds))
+        self.anchor = anchor
         geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
-        if self._changed("geometry", (geometry_key, tuple(o.name for o in voxelized))):
-            pos = (np.concatenate([o.positions for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
+
+        def relative(objs):
+            if not objs:
+                return np.zeros((0, 3, 3), np.float32)
+            return np.concatenate([(o.positions + (o.offset - anchor)).astype(np.float32) for o in objs])
+
+        if self._changed("geometry", (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes())):
+            pos = relative(objects)
             nrm = (np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
             flags = np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects]) \
                 if objects else np.zeros(0, np.float32)
-            vpos = (np.concatenate([o.positions for o in voxelized]) if voxelized else np.zeros((0, 3, 3), np.float32))
+            vpos = relative(voxelized)
             solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
                      else np.zeros(0, bool))
             self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
             self.gbuffer.set_geometry(pos, nrm, flags)
             self.back.set_geometry(pos, nrm, flags)
             self.stats["upload"] += 1
-        bounds = region if region is not None else scene_bounds(objects)
-        if bounds is None:
-            raise BakeInputError("nothing to render: no visible mesh objects")
-        self.spec = grid_for_bounds(bounds[0], bounds[1], settings.grid)
+        self.spec = grid_for_bounds(np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor, settings.grid)
         # Only objects reaching into the region can change the grid: one moving outside a
         # user region re-renders the G-buffer but is not re-voxelized.
-        lo, hi = np.asarray(self.spec.origin), np.asarray(self.spec.origin) + np.asarray(self.spec.dims) * self.spec.voxel
-        inside = tuple(k for o, k in zip(objects, geometry_key)
-                       if o in voxelized and _box_overlaps(o.positions, lo, hi))
-        grid_key = (inside, self.spec)
+        lo = np.asarray(self.spec.origin) + anchor
+        hi = lo + np.asarray(self.spec.dims) * self.spec.voxel
+        inside = tuple(k for o, k in zip(objects, geometry_key) if o in voxelized and len(o.positions)
+                       and _boxes_overlap(*o.world_bounds(), lo, hi))
+        grid_key = (inside, self.spec, anchor.tobytes())
         use_voxels = settings.method in ("hao", "hao+far")
         if use_voxels and self._changed("grid", grid_key):
             self.voxels.voxelize(self.spec)
             self.stats["voxelize"] += 1
+        shift = np.identity(4)
+        shift[:3, 3] = anchor
+        view_proj = np.asarray(view_proj, np.float64) @ shift  # anchor-relative -> clip
+        if spheres is not None:
+            spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
         view_key = (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height)
         if self._changed("view", view_key):
             self.gbuffer.render(view_proj, width, height)
