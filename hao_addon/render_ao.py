@@ -20,6 +20,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     (its skips then apply across calls); by default a temporary one."""
     from .gpu.context import ensure_gpu_context
     from .gpu.hao_renderer import HaoRenderer
+    from .gpu.util import texture_to_numpy
 
     if camera is None or camera.type != 'CAMERA':
         raise BakeInputError("no camera: pass --camera NAME or give the scene a camera")
@@ -39,7 +40,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     try:
         renderer.render(objects, view_proj, width, height, settings, region, spheres)
         ao = renderer.read_ao()
-        coverage = renderer.gbuffer.read()[0][..., 3] > 0.0
+        coverage = texture_to_numpy(renderer.gbuffer.position)[..., 3] > 0.0
     finally:
         if own:
             renderer.free()

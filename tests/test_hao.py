@@ -211,8 +211,9 @@ def test_far_from_the_origin_and_at_any_scale(renderer):
     base = renderer.read_ao()
     for shift, scale in ((np.array([1e5, -2e5, 3e4]), 1.0), (np.array([1e5 + 0.37, 0.0, 0.0]), 1.0),
                          (np.zeros(3), 1e-3), (np.zeros(3), 1e4)):
-        moved = [object_from_soup(TriangleSoup(s.positions * scale + shift, s.uvs, s.name), f"{s.name}{scale}")
-                 for s in soups]
+        # A new key for new geometry (the renderer's change contract).
+        moved = [object_from_soup(TriangleSoup(s.positions * scale + shift, s.uvs, s.name),
+                                  f"{s.name}{shift}{scale}") for s in soups]
         vp2 = (cm.perspective(0.9, w / h, 0.05 * scale, 100.0 * scale)
                @ cm.look_at(eye * scale + shift, target * scale + shift))
         renderer.render(moved, vp2, w, h, settings.with_(max_distance=scale))

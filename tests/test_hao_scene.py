@@ -223,7 +223,8 @@ def test_composite_darkens_by_ao_and_respects_depth(renderer):
     # "Blender's" depth buffer: the same meshes drawn again (so the surfaces are front-most),
     # or a depth buffer cleared to 0 (something nearer everywhere).
     viewport = GBufferPass()
-    viewport.set_geometry(np.concatenate([o.world_positions() for o in objs]).astype(np.float32), np.concatenate([o.normals for o in objs]),
+    viewport.set_geometry(np.concatenate([o.world_positions() for o in objs]).astype(np.float32),
+                          np.concatenate([o.normals for o in objs]),
                           np.ones(sum(len(o.positions) for o in objs), np.float32))
     viewport.render(vp, w, h)
     nearer_depth = gpu.types.GPUTexture((w, h), format='DEPTH_COMPONENT32F')

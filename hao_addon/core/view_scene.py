@@ -51,9 +51,12 @@ def object_from_soup(soup: TriangleSoup, key: object = 0, receiver: float = 1.0)
                        boundary_edge_fraction(soup.positions) <= SOLID_BORDER_FRACTION, offset=offset)
 
 
-def scene_bounds(objects: list[SceneObject]) -> tuple[np.ndarray, np.ndarray] | None:
-    """World box (lo, hi) of all triangles, None when there are none."""
-    boxes = [o.world_bounds() for o in objects if len(o.positions)]
+def scene_bounds(objects: list[SceneObject], boxes: list | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+    """World box (lo, hi) of all triangles, None when there are none. boxes: the objects'
+    world_bounds() (None for empty objects) when the caller already has them."""
+    if boxes is None:
+        boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
+    boxes = [b for b in boxes if b is not None]
     if not boxes:
         return None
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)

@@ -34,6 +34,18 @@ def gbuffer_shader(back_layer: bool = False) -> "gpu.types.GPUShader":
     return cached_shader(("hao_gbuffer", back_layer), lambda: _gbuffer_info(back_layer))
 
 
+def declare_gbuffer_images(info: "gpu.types.GPUShaderCreateInfo") -> None:
+    """Declare the G-buffer as read-only images 0 (gbuf_position) and 1 (gbuf_normal), the
+    interface every pass reading the G-buffer shares (bind with bind_gbuffer_images)."""
+    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
+    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+
+
+def bind_gbuffer_images(shader: "gpu.types.GPUShader", gbuffer: "GBufferPass") -> None:
+    shader.image("gbuf_position", gbuffer.position)
+    shader.image("gbuf_normal", gbuffer.normal)
+
+
 class GBufferPass(util.GPUPass):
     """Owns the mesh batch and the G-buffer textures (reallocated when the size changes).
     back_layer: the nearest back faces with their own normals (front faces culled), the

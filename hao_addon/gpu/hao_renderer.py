@@ -50,6 +50,7 @@ class HaoRenderer(util.GPUPass):
         self._keys: dict[str, object] = {}
         self.spec: GridSpec | None = None
         self.anchor = np.zeros(3)  # world point the GPU passes' positions are relative to
+        self._boxes: list = []
 
     def _changed(self, name: str, key: object) -> bool:
         if self._keys.get(name) == key:
@@ -62,7 +63,16 @@ class HaoRenderer(util.GPUPass):
                spheres: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Run what changed since the last call. view_proj: (4, 4) world -> clip;
         region: world box (lo, hi) of the region of interest, default the objects' bounds;
-        spheres: (centres (K, 3), radii (K,)) sphere proxies for the 'far' methods."""
+        spheres: (centres (K, 3), radii (K,)) sphere proxies for the 'far' methods.
+        On an error no compute shader stays bound (draw passes restore their own state)."""
+        try:
+            self._render(objects, view_proj, width, height, settings, region, spheres)
+        except BaseException:
+            gpu.shader.unbind()
+            self._keys.clear()  # a pass may have stopped half way: redo everything next time
+            raise
+
+    def _render(self, objects, view_proj, width, height, settings, region, spheres) -> None:
         settings = settings.validated()
         if width < 1 or height < 1:
             raise BakeInputError(f"image size must be positive, got {width}x{height}")
@@ -70,7 +80,12 @@ class HaoRenderer(util.GPUPass):
         # With 'hao+far' the spheres stand in for the objects that have them: those are drawn
         # and receive AO but are not voxelized, so no occluder is counted twice.
         voxelized = [o for o in objects if not (settings.method == "hao+far" and o.proxied)]
-        world_bounds = scene_bounds(objects)
+        geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
+        # Object boxes are a pass over every triangle: only when an object changed.
+        if self._changed("boxes", geometry_key):
+            self._boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
+        boxes = self._boxes
+        world_bounds = scene_bounds(objects, boxes)
         bounds = region if region is not None else world_bounds
         if bounds is None:
             raise BakeInputError("nothing to render: no visible mesh objects")
@@ -78,7 +93,6 @@ class HaoRenderer(util.GPUPass):
         # origin); G-buffer positions read back are relative to it (self.anchor).
         anchor = render_anchor(*(world_bounds if world_bounds is not None else bounds))
         self.anchor = anchor
-        geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
 
         def relative(objs):
             if not objs:
@@ -102,8 +116,8 @@ class HaoRenderer(util.GPUPass):
         # user region re-renders the G-buffer but is not re-voxelized.
         lo = np.asarray(self.spec.origin) + anchor
         hi = lo + np.asarray(self.spec.dims) * self.spec.voxel
-        inside = tuple(k for o, k in zip(objects, geometry_key) if o in voxelized and len(o.positions)
-                       and _boxes_overlap(*o.world_bounds(), lo, hi))
+        inside = tuple(k for o, k, box in zip(objects, geometry_key, boxes)
+                       if box is not None and o in voxelized and _boxes_overlap(*box, lo, hi))
         grid_key = (inside, self.spec, anchor.tobytes())
         use_voxels = settings.method in ("hao", "hao+far")
         if use_voxels and self._changed("grid", grid_key):

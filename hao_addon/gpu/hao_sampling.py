@@ -7,6 +7,7 @@ import numpy as np
 
 from ..core.view_settings import ViewAOSettings
 from . import util
+from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import cached_shader, glsl_source
 
 GROUP = 8
@@ -23,8 +24,7 @@ def _ao_info() -> "gpu.types.GPUShaderCreateInfo":
     info.push_constant('INT', "steps")
     info.push_constant('FLOAT', "spread")
     info.push_constant('FLOAT', "max_distance")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
-    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    declare_gbuffer_images(info)
     info.image(2, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
     info.image(4, 'R32UI', 'UINT_2D', "sampled_count", qualifiers={'READ', 'WRITE'})
@@ -42,8 +42,7 @@ def _bilateral_info(axis: int, upsample: bool) -> "gpu.types.GPUShaderCreateInfo
     info.push_constant('INT', "scale")
     info.push_constant('INT', "filter_size")
     info.push_constant('FLOAT', "max_distance")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
-    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    declare_gbuffer_images(info)
     info.image(2, 'R32F', 'FLOAT_2D', "ao_src", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_dst", qualifiers={'WRITE'})
     info.compute_source(glsl_source("hao_common.glsl", "hao_bilateral.comp"))
@@ -55,8 +54,7 @@ def _pick_low_info() -> "gpu.types.GPUShaderCreateInfo":
     info.local_group_size(GROUP, GROUP, 1)
     info.push_constant('IVEC2', "full_size")
     info.push_constant('INT', "scale")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
-    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    declare_gbuffer_images(info)
     info.image(2, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'WRITE'})
     info.image(3, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'WRITE'})
     info.compute_source(glsl_source("hao_pick.glsl", "hao_pick_low.comp"))
@@ -82,8 +80,7 @@ class LowGBufferPass(util.GPUPass):
         shader.bind()
         shader.uniform_int("full_size", (width, height))
         shader.uniform_int("scale", scale)
-        shader.image("gbuf_position", gbuffer.position)
-        shader.image("gbuf_normal", gbuffer.normal)
+        bind_gbuffer_images(shader, gbuffer)
         shader.image("low_position", self.position)
         shader.image("low_normal", self.normal)
         gpu.compute.dispatch(shader, -(-low[0] // GROUP), -(-low[1] // GROUP), 1)
@@ -152,8 +149,7 @@ class AOSamplingPass(util.GPUPass):
         shader.uniform_int("steps", settings.steps)
         shader.uniform_float("spread", settings.spread)
         shader.uniform_float("max_distance", settings.max_distance)
-        shader.image("gbuf_position", gbuffer.position)
-        shader.image("gbuf_normal", gbuffer.normal)
+        bind_gbuffer_images(shader, gbuffer)
         shader.image("grid", voxels.grid)
         shader.image("ao_low", self.ao_low)
         shader.image("sampled_count", self.counter)
@@ -194,8 +190,7 @@ class BilateralPass(util.GPUPass):
             _set_optional(shader, "scale", settings.scale, integer=True)
             shader.uniform_int("filter_size", settings.filter_size)
             shader.uniform_float("max_distance", settings.max_distance)
-            shader.image("gbuf_position", gbuffer.position)
-            shader.image("gbuf_normal", gbuffer.normal)
+            bind_gbuffer_images(shader, gbuffer)
             shader.image("ao_src", src)
             shader.image("ao_dst", dst)
             gpu.compute.dispatch(shader, -(-width // GROUP), -(-height // GROUP), 1)

@@ -63,6 +63,7 @@ class VoxelPass(util.GPUPass):
         self.grid = None
         self.spec: GridSpec | None = None
         self.triangles = 0
+        self._plane, self._plane_fb, self._plane_side = None, None, 0
 
     def set_geometry(self, positions: np.ndarray, axes: np.ndarray, solid: np.ndarray) -> None:
         """positions: (F, 3, 3) world; axes: (F,) dominant axis; solid: (F,) bool, triangles
@@ -82,20 +83,18 @@ class VoxelPass(util.GPUPass):
         self.spec = spec
         self.grid.clear(format='UINT', value=(0,))
         side = max(spec.dims)
-        dummy = gpu.types.GPUTexture((side, side), format='R8')
-        fb = gpu.types.GPUFrameBuffer(color_slots=dummy)
-        with util.scoped_state(), fb.bind():
+        if self._plane_side != side:  # the colour target only sizes the raster plane
+            self._plane = gpu.types.GPUTexture((side, side), format='R8')  # kept alive with its framebuffer
+            self._plane_fb = gpu.types.GPUFrameBuffer(color_slots=self._plane)
+            self._plane_side = side
+        with util.scoped_state(), self._plane_fb.bind():
             util.set_overlay_pass_state(side, side)
             # Parity first, then the surface ORed over it: XOR and OR do not commute.
             for solid, batch in ((True, self.solid_batch), (False, self.surface_batch)):
                 if batch is None:
                     continue
-                if solid:
-                    gpu.state.viewport_set(0, 0, spec.dims[0], spec.dims[1])
-                    size = (spec.dims[0], spec.dims[1])
-                else:
-                    gpu.state.viewport_set(0, 0, side, side)
-                    size = (side, side)
+                size = (spec.dims[0], spec.dims[1]) if solid else (side, side)  # solid: columns along z
+                gpu.state.viewport_set(0, 0, *size)
                 shader = voxelize_shader(solid)
                 shader.bind()
                 shader.uniform_float("grid_origin", (*spec.origin, spec.voxel))
@@ -123,3 +122,4 @@ class VoxelPass(util.GPUPass):
 
     def _release(self) -> None:
         self.surface_batch = self.solid_batch = self.grid = None
+        self._plane, self._plane_fb, self._plane_side = None, None, 0

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..core.near_field import camera_terms
 from .hao_sampling import GROUP
+from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import cached_shader, glsl_source
 
 
@@ -21,8 +22,7 @@ def _near_info() -> "gpu.types.GPUShaderCreateInfo":
     info.push_constant('FLOAT', "proj_scale")
     info.push_constant('VEC4', "view_proj_row3")
     info.push_constant('VEC4', "eye")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "gbuf_position", qualifiers={'READ'})
-    info.image(1, 'RGBA32F', 'FLOAT_2D', "gbuf_normal", qualifiers={'READ'})
+    declare_gbuffer_images(info)
     info.image(2, 'RGBA32F', 'FLOAT_2D', "back_position", qualifiers={'READ'})
     info.image(3, 'RGBA32F', 'FLOAT_2D', "back_normal", qualifiers={'READ'})
     info.image(4, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
@@ -48,8 +48,7 @@ def run_near_field(front, back, ao_low, scale: int, view_proj: np.ndarray, r_far
     shader.uniform_float("proj_scale", proj_scale)
     shader.uniform_float("view_proj_row3", tuple(row3))
     shader.uniform_float("eye", tuple(eye))
-    shader.image("gbuf_position", front.position)
-    shader.image("gbuf_normal", front.normal)
+    bind_gbuffer_images(shader, front)
     shader.image("back_position", back.position)
     shader.image("back_normal", back.normal)
     shader.image("ao_low", ao_low)

@@ -77,6 +77,7 @@ class FarSpheresPass(util.GPUPass):
     def __init__(self) -> None:
         super().__init__()
         self.stats = dict(spheres_drawn=0, spheres_culled=0)
+        self._fb = self._fb_target = None
 
     def run(self, low_gbuffer, ao_map, centres: np.ndarray, radii: np.ndarray, epsilon: float,
             view_proj: np.ndarray) -> None:
@@ -97,11 +98,15 @@ class FarSpheresPass(util.GPUPass):
         sphere = np.repeat(np.concatenate([centres[keep], radii[keep, None]], axis=1), 6, axis=0)
         batch = util.make_batch('TRIS', {"corner": ('F32', corners), "sphere": ('F32', sphere),
                                          "reach": ('F32', np.repeat(reach[keep], 6))})
-        fb = gpu.types.GPUFrameBuffer(color_slots=ao_map)
-        with util.scoped_state(), fb.bind():
+        if self._fb_target is not ao_map:  # the AO map is reallocated only on resize
+            self._fb, self._fb_target = gpu.types.GPUFrameBuffer(color_slots=ao_map), ao_map
+        with util.scoped_state(), self._fb.bind():
             util.set_overlay_pass_state(ao_map.width, ao_map.height, blend='MULTIPLY')
             shader = far_shader()
             shader.bind()
             shader.image("low_position", low_gbuffer.position)
             shader.image("low_normal", low_gbuffer.normal)
             batch.draw(shader)
+
+    def _release(self) -> None:
+        self._fb = self._fb_target = None
