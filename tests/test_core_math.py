@@ -192,6 +192,88 @@ def test_closed_surface_detection():
     assert not is_closed_surface(scenes.grid_plane(2.0, 4).positions)  # open sheet
     assert not is_closed_surface(np.zeros((0, 3, 3)))
     assert is_closed_surface(scenes.box((0, 0, 0), (1, 2, 3)).positions)
+    assert not is_closed_surface(torus[:, ::-1])  # closed but inside out: faces point in
+
+
+def test_surface_holes_are_the_border_loops_of_solids():
+    from hao_addon.core import scenes
+    from hao_addon.core.geometry import surface_holes
+    torus = scenes.torus(1.0, 0.4, (0, 0, 0), 24, 12).positions
+    assert surface_holes(torus) == []
+    # Two holes: one face, and a quad (face 100 and a face sharing an edge with it).
+    shared = [len({tuple(p) for p in torus[100]} & {tuple(p) for p in f}) for f in torus]
+    partner = next(i for i, n in enumerate(shared) if n == 2)
+    holed = np.delete(torus, [0, 100, partner], axis=0)
+    holes = surface_holes(holed)
+    assert sorted(len(h) for h in holes) == [3, 4]
+    loop_points = {tuple(p) for h in holes for p in h}
+    assert loop_points == {tuple(p) for p in np.concatenate([torus[0], torus[100], torus[partner]])}
+    assert surface_holes(holed[:, ::-1]) is None  # inside out
+    assert surface_holes(scenes.grid_plane(2.0, 4).positions) is None  # a sheet bounds nothing
+    assert surface_holes(np.concatenate([holed, holed[:1]])) is None  # a fin
+    # A solid beside an inside-out solid: the total volume is positive, one part's is not.
+    big = scenes.torus(3.0, 1.0, (0, 0, 9), 24, 12).positions
+    assert surface_holes(np.concatenate([big, torus[:, ::-1]])) is None
+    assert surface_holes(np.concatenate([big, torus])) == []
+    # A curved sheet (a hemisphere's cap, fanned shut) facing inwards: None; outwards: a hole.
+    dome = scenes.uv_sphere(1.0, (0, 0, 20), 24, 12).positions
+    dome = dome[dome[:, :, 2].min(axis=1) >= 20.0]
+    assert surface_holes(np.concatenate([big, dome])) is not None
+    assert surface_holes(np.concatenate([big, dome[:, ::-1]])) is None
+    # Two separate solids, one with a hole, far from the origin: still found.
+    two = np.concatenate([holed, scenes.box((5, 0, 0), (6, 1, 1)).positions]) + 1e5
+    assert sorted(len(h) for h in surface_holes(two)) == [3, 4]
+
+
+def test_weld_matches_unique_rows():
+    from hao_addon.core.geometry import weld
+    rng = np.random.default_rng(3)
+    pts = rng.random((500, 3)).round(1)  # many exact repeats
+    first, inverse = weld(pts)
+    np.testing.assert_array_equal(pts[first][inverse], pts)
+    assert len(first) == len(np.unique(pts, axis=0))
+
+
+def test_face_chunks_and_hole_runs_are_conservative():
+    """Every face turned away from a view whose light-view box meets a hole's box (and lies
+    past the hole) falls in a returned run; the runs cover far fewer faces than all."""
+    from hao_addon.core import scenes
+    from hao_addon.core.directions import bake_directions
+    from hao_addon.core.face_chunks import CHUNK_FACES, face_chunks, hole_chunk_ranges
+    from hao_addon.core.geometry import face_normals_areas, surface_holes
+    from hao_addon.core.views import fit_view
+    torus = scenes.torus(1.0, 0.4, (0, 0, 0), 96, 48).positions
+    # A 3 x 3 patch of quads cut out (quad q is faces q and q + half; quad (i, j) = 48 i + j).
+    quads = np.array([48 * i + j for i in (10, 11, 12) for j in (20, 21, 22)])
+    holed = np.delete(torus, np.concatenate([quads, quads + len(torus) // 2]), axis=0)
+    holes = surface_holes(holed)
+    assert [len(h) for h in holes] == [12]
+    chunks = face_chunks(holed)
+    assert np.array_equal(np.sort(chunks.order), np.arange(len(holed)))
+    ordered = holed[chunks.order]
+    for c, box in enumerate(chunks.boxes):  # each chunk's box holds its faces
+        part = ordered[c * CHUNK_FACES:(c + 1) * CHUNK_FACES].reshape(-1, 3)
+        assert (part >= box[0]).all() and (part <= box[1]).all()
+    normals, _ = face_normals_areas(ordered)
+    points = np.unique(holed.reshape(-1, 3), axis=0)
+    drawn_total = 0
+    for omega in bake_directions(32, 5):
+        view = fit_view(omega, points, None, 0.01, np.zeros(2), 4096)
+        runs = hole_chunk_ranges(chunks, holes, view.matrix, len(holed))
+        in_run = np.zeros(len(holed), bool)
+        for first, count in runs:
+            in_run[first:first + count] = True
+        drawn_total += in_run.sum()
+        clip = ordered.reshape(-1, 3) @ view.matrix[:3, :3].T.astype(np.float64) + view.matrix[:3, 3]
+        clip = clip.reshape(-1, 3, 3)
+        for h in holes:
+            hc = h @ view.matrix[:3, :3].T.astype(np.float64) + view.matrix[:3, 3]
+            meets = ((clip[..., :2].min(axis=1) <= hc[:, :2].max(axis=0))
+                     & (hc[:, :2].min(axis=0) <= clip[..., :2].max(axis=1))).all(axis=1)
+            meets &= clip[..., 2].max(axis=1) >= hc[:, 2].min()
+            needed = meets & (normals @ omega < 0)
+            assert in_run[needed].all()
+    assert drawn_total < 0.25 * 32 * len(holed)
 
 
 def test_written_files_get_normal_permissions_and_rgba_png_header(tmp_path):

@@ -92,3 +92,39 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
     plane = scenes.grid_plane(4.0, 4, z=-0.5)
     assert not make_plan(tilted, [plane], BakeSettings(size=64, directions=8)).depth_map_culls_back_faces
     assert not make_plan(tilted, [], BakeSettings(size=64, directions=8, max_distance=1.0)).depth_map_culls_back_faces
+
+
+def test_gather_draws_averted_faces_only_where_the_light_looks_into_a_hole(gpu_context):
+    """Everything drawn bounds solids, but the occluding torus has holes in its top. The light
+    views draw light-facing faces plus averted ones only in the chunks behind a hole's outline,
+    and the map equals the one from drawing every face. Dropping those chunks too (as if the
+    torus were closed) lets light through the holes onto the sphere below: the runs matter."""
+    import dataclasses
+
+    from hao_addon.core.plan import make_plan
+    from hao_addon.core.seams import finalize_map
+    from hao_addon.gpu import baker_for
+
+    sphere = scenes.uv_sphere(0.5, (0.0, 0.0, 0.0), 64, 32)
+    segments, sides = 96, 48
+    torus = scenes.torus(0.5, 0.25, (0.0, 0.0, 0.9), segments, sides)
+    top = sides // 4  # quads (i, top) sit on the top of the tube; every 24th is cut out
+    quads = np.array([i * sides + top for i in range(0, segments, 24)])
+    holed = TriangleSoup(np.delete(torus.positions, np.concatenate([quads, quads + len(torus.positions) // 2]), axis=0))
+    settings = BakeSettings(size=128, directions=64, margin=0, method="gather")
+    plan = make_plan(sphere, [holed], settings)
+    assert len(plan.holes) == len(quads) and plan.stats["holes"] == len(quads)
+    maps, stats = [], []
+    for holes in (plan.holes, None, []):
+        baker = baker_for("gather")(dataclasses.replace(plan, holes=holes))
+        try:
+            for i in range(settings.directions):
+                baker.run_direction(i)
+            maps.append(finalize_map(*baker.accumulated(), 0))
+            stats.append(dict(baker.stats))
+        finally:
+            baker.free()
+    (runs, covered, _), (every_face, _, _), (front_only, _, _) = maps
+    np.testing.assert_array_equal(runs, every_face)
+    assert 0 < stats[0]["averted_faces_drawn"] < stats[0]["averted_faces_skipped"]
+    assert (front_only - every_face)[covered].max() > 0.02  # light leaks through the holes

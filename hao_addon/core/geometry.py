@@ -67,44 +67,143 @@ def bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 
-def is_closed_surface(positions: np.ndarray) -> bool:
-    """True when (F, 3, 3) triangles form closed, consistently oriented surfaces: after
-    welding bit-identical corner positions, every directed edge a->b occurs exactly once and
-    its reverse b->a exactly once (no border, no fin, no flipped face).
+def weld(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge bit-identical points (n, 3) float64: (first (V,) index of each distinct point,
+    inverse (n,) its number per point), numbered in order of a 64-bit hash of the bits.
 
-    Why it matters: seen from outside, the first surface a ray meets on a closed surface is
-    always an entry, i.e. faces the viewer, so a depth map of the front faces alone equals the
-    depth map of all faces, and back faces need not be drawn (about 40 % of a light view's
-    rasterization cost on llvmpipe). Separate closed objects, touching or intersecting, keep
-    the property.
+    A sort of hashes instead of np.unique over rows (4x faster: 15 ms for 200k corners); the
+    result is checked exactly and recomputed by rows in the (never seen) case of a collision.
     """
-    corners = np.ascontiguousarray(np.asarray(positions, dtype=np.float64).reshape(-1, 3))
-    if len(corners) == 0:
-        return False
-    keys = corners.view(np.dtype((np.void, corners.dtype.itemsize * 3))).ravel()
-    _, vertex = np.unique(keys, return_inverse=True)
-    tri = vertex.reshape(-1, 3).astype(np.int64)
+    pts = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    bits = pts.view(np.uint64)
+    with np.errstate(over="ignore"):
+        key = (bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)) ^ (bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)) ^ bits[:, 2]
+    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    if not np.array_equal(bits, bits[first[inverse]]):
+        keys = pts.view(np.dtype((np.void, 24))).ravel()
+        _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        inverse = inverse.ravel()
+    return first, inverse
+
+
+def _welded_triangles(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (V, 3) float64, triangles (F, 3) int64): corners welded when bit-identical."""
+    corners = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    first, vertex = weld(corners)
+    return corners[first], vertex.reshape(-1, 3).astype(np.int64)
+
+
+def surface_holes(positions: np.ndarray) -> list[np.ndarray] | None:
+    """The holes of (F, 3, 3) triangles that bound solids: one (k, 3) float64 array of
+    boundary-loop vertices per hole, [] for closed surfaces, None when the triangles do not
+    bound solids even after capping their holes.
+
+    Bounding solids means: after welding bit-identical corners, every directed edge a->b occurs
+    at most once (no fin, no flipped face), each border vertex starts and ends exactly one
+    border edge (the border splits into simple loops), and with every loop capped by a fan to
+    its centroid (which closes it: cap (b, a, c) pairs border edge a->b) the signed volume is
+    positive (faces point out). Separate objects, touching or intersecting, may each be such.
+
+    Why it matters: a ray from outside first crosses such a capped surface where it enters,
+    at a face that looks towards the ray's origin or at a cap. So a depth map from a light
+    equals the map of the light-facing faces alone except inside the light-view outline of a
+    hole (the cap lies in the convex hull of its loop): faces turned away from the light are
+    needed only there (on llvmpipe they cost about 40 % of a light view).
+    """
+    if len(np.asarray(positions).reshape(-1, 9)) == 0:
+        return None
+    verts, tri = _welded_triangles(positions)
     a = tri.ravel()
     b = np.roll(tri, -1, axis=1).ravel()
-    if (a == b).any():  # a collapsed edge has no partner
-        return False
-    n = int(vertex.max()) + 1
-    forward = np.sort(a * n + b)
-    if (np.diff(forward) == 0).any():  # a directed edge used twice: fin or flipped neighbour
-        return False
-    return bool(np.array_equal(forward, np.sort(b * n + a)))
+    if (a == b).any():  # a collapsed edge: no consistent orientation to speak of
+        return None
+    n = len(verts)
+    forward = a * n + b
+    order = np.sort(forward)
+    if (np.diff(order) == 0).any():  # a directed edge used twice: fin or flipped neighbour
+        return None
+    # Edge a->b is a border edge when no face walks b->a, i.e. a * n + b is not a reversed
+    # edge. Both lists sorted: searchsorted with sorted queries runs in cache order.
+    reversed_sorted = np.sort(b * n + a)
+    slot = np.minimum(np.searchsorted(reversed_sorted, order), len(order) - 1)
+    border = order[reversed_sorted[slot] != order]
+    start, end = border // n, border % n
+    if len(np.unique(start)) != len(start) or len(np.unique(end)) != len(end):
+        return None  # a border vertex with two loops through it
+    successor = dict(zip(start.tolist(), end.tolist()))
+    loops, seen = [], set()
+    for first in successor:
+        if first in seen:
+            continue
+        loop, v = [], first
+        while v not in seen:
+            seen.add(v)
+            loop.append(v)
+            v = successor.get(v, -1)
+            if v < 0:
+                return None
+        loops.append(np.array(loop))
+    # Signed volume of each connected part plus its caps (divergence theorem, corners relative
+    # to the mean so large offsets do not cancel digits). Every part must enclose a positive
+    # volume: one inside-out part (or a sheet, which capped by itself encloses nothing) among
+    # solids would break the argument above where it is, whatever the total.
+    p = verts - verts.mean(axis=0)
+    part = component_labels(tri, n)
+    det = np.einsum("ij,ij->i", p[tri[:, 0]], np.cross(p[tri[:, 1]], p[tri[:, 2]]))
+    loop_of = np.empty(n, np.int64)
+    centroids = np.zeros((len(loops), 3))
+    for i, loop in enumerate(loops):
+        loop_of[loop] = i
+        centroids[i] = p[loop].mean(axis=0)
+    owner = part[tri[:, 0]]
+    if len(loops):
+        cap_det = np.einsum("ij,ij->i", p[end], np.cross(p[start], centroids[loop_of[start]]))
+        det = np.concatenate([det, cap_det])
+        owner = np.concatenate([owner, part[start]])
+    volume = np.bincount(owner, weights=det, minlength=n)
+    size = np.bincount(owner, weights=np.abs(det), minlength=n)
+    used = np.unique(owner)
+    if not (volume[used] > 1e-6 * size[used]).all():
+        return None
+    return [verts[loop] for loop in loops]
+
+
+def component_labels(tri: np.ndarray, vertex_count: int) -> np.ndarray:
+    """(V,) int64 label of each vertex's connected part (the smallest vertex number in it)
+    for (F, 3) int vertex triangles. Hooking of roots plus pointer jumping: a few passes
+    (6 for the 35k-vertex bunny, 16 ms)."""
+    label = np.arange(vertex_count)
+    corners = tri.ravel()
+    while True:
+        smallest = np.repeat(label[tri].min(axis=1), 3)
+        new = label.copy()
+        np.minimum.at(new, label[corners], smallest)  # hook each corner's root to the minimum
+        while True:
+            jumped = new[new]
+            if np.array_equal(jumped, new):
+                break
+            new = jumped
+        if np.array_equal(new, label):
+            return label
+        label = new
+
+
+def is_closed_surface(positions: np.ndarray) -> bool:
+    """True when (F, 3, 3) triangles form closed, consistently and outward oriented surfaces:
+    every directed edge a->b occurs exactly once and its reverse b->a exactly once after
+    welding bit-identical corners (no border, no fin, no flipped face), and the enclosed
+    volume is positive. See surface_holes for why it matters."""
+    return surface_holes(positions) == []
 
 
 def boundary_edge_fraction(positions: np.ndarray) -> float:
     """Fraction of the (welded, undirected) edges of (F, 3, 3) triangles that belong to one
     face only: 0 for a closed surface, small for a scan with a few holes, large for sheets."""
-    corners = np.ascontiguousarray(np.asarray(positions, dtype=np.float64).reshape(-1, 3))
-    if len(corners) == 0:
+    if len(np.asarray(positions).reshape(-1, 9)) == 0:
         return 1.0
-    keys = corners.view(np.dtype((np.void, corners.dtype.itemsize * 3))).ravel()
-    _, vertex = np.unique(keys, return_inverse=True)
-    tri = vertex.reshape(-1, 3).astype(np.int64)
+    verts, tri = _welded_triangles(positions)
     a, b = tri.ravel(), np.roll(tri, -1, axis=1).ravel()
-    n = int(vertex.max()) + 1
+    n = len(verts)
     _, counts = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
     return float((counts == 1).sum() / len(counts))

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .directions import bake_directions
-from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, is_closed_surface, uv_areas
+from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, surface_holes, uv_areas, weld
 from .normalization import face_normalizers
 from .settings import BakeSettings
 from .views import OrthoView, fit_view
@@ -52,6 +52,10 @@ class BakePlan:
     drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
     needs_footprint_splat: bool = False
     closed_surfaces: bool = False  # everything drawn is closed and consistently oriented
+    # Hole loops (k, 3) normalized of everything drawn when it bounds solids once capped
+    # (core/geometry.surface_holes; [] when closed); None when not, or not needed (a max
+    # distance or ignored back faces change what a depth map must hold).
+    holes: list[np.ndarray] | None = None
     stats: dict = field(default_factory=dict)
 
     @property
@@ -155,18 +159,22 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
 
     drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
-    closed = (settings.max_distance == 0.0 and not settings.ignore_back_faces
-              and is_closed_surface(np.concatenate([target.positions] + [o.positions for o in occluders if o.face_count])))
+    holes = None
+    if settings.max_distance == 0.0 and not settings.ignore_back_faces:
+        holes = surface_holes(drawn.reshape(-1, 3, 3))
+    closed = holes == []
     drawn_sphere = bounding_sphere(drawn)
-    target_points = np.unique(t_pos.reshape(-1, 3), axis=0) if len(t_pos) < 2_000_000 else t_pos.reshape(-1, 3)
+    # Distinct corners: a light view's window is fitted to them (shared corners once).
+    target_points = t_pos.reshape(-1, 3)[weld(t_pos.reshape(-1, 3))[0]]
 
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
                  occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
-                 dense_uv_area_fraction=dense_fraction, closed_surfaces=closed)
+                 dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
+                 holes=-1 if holes is None else len(holes))
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32),
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
                     pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere,
-                    dense_fraction > DENSE_AREA_LIMIT, closed, stats)
+                    dense_fraction > DENSE_AREA_LIMIT, closed, holes, stats)

@@ -27,31 +27,48 @@ def _shift(a: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
 
 def dilate(values: np.ndarray, valid: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
     """Grow the valid region by `rings` texels, each new texel the mean of its valid
-    8-neighbours. values: (H, W) float; valid: (H, W) bool. Returns new (values, valid)."""
-    values = values.astype(np.float32, copy=True)
-    valid = valid.copy()
+    8-neighbours. values: (H, W) float; valid: (H, W) bool. Returns new (values, valid).
+
+    Works on the frontier only (the invalid texels next to valid ones, ring by ring), so the
+    cost follows the texels grown, not the map: 1024^2 with 18 rings went from 0.38 s (whole
+    shifted images per ring) to a few tens of ms. Sums run in the same neighbour order in
+    float32 as whole-image shifts would, so the result does not depend on the method.
+    """
+    h, w = valid.shape
+    pw = w + 2  # one texel of never-valid padding: neighbours never leave the array
+    vals = np.zeros((h + 2) * pw, np.float32)
+    ok = np.zeros((h + 2) * pw, bool)
+    inside = np.zeros((h + 2, pw), bool)
+    inside[1:-1, 1:-1] = True
+    inside = inside.ravel()
+    vals.reshape(h + 2, pw)[1:-1, 1:-1] = np.where(valid, values, 0.0)
+    ok.reshape(h + 2, pw)[1:-1, 1:-1] = valid
+    offsets = np.array([dy * pw + dx for dy, dx in _OFFSETS])
+    okg = ok.reshape(h + 2, pw)
+    near = np.zeros_like(okg)
+    for dy, dx in _OFFSETS:  # first frontier: whole-image shifts, once
+        near[1:-1, 1:-1] |= okg[1 + dy:h + 1 + dy, 1 + dx:w + 1 + dx]
+    frontier = np.flatnonzero(near.ravel() & ~ok & inside)
+    mark = np.zeros_like(ok)
     for _ in range(rings):
-        # Work only in the bounding box of the frontier (one texel around the valid set).
-        rows = np.flatnonzero(valid.any(axis=1))
-        cols = np.flatnonzero(valid.any(axis=0))
-        if len(rows) == 0:
+        if len(frontier) == 0:
             break
-        y0, y1 = max(rows[0] - 1, 0), min(rows[-1] + 2, valid.shape[0])
-        x0, x1 = max(cols[0] - 1, 0), min(cols[-1] + 2, valid.shape[1])
-        v, m = values[y0:y1, x0:x1], valid[y0:y1, x0:x1]
-        total = np.zeros(v.shape, np.float32)
-        count = np.zeros(v.shape, np.float32)
-        vm = np.where(m, v, 0.0).astype(np.float32)
-        mf = m.astype(np.float32)
-        for dy, dx in _OFFSETS:
-            total += _shift(vm, dy, dx, 0.0)
-            count += _shift(mf, dy, dx, 0.0)
-        grow = (~m) & (count > 0)
-        if not grow.any():
-            break
-        v[grow] = total[grow] / count[grow]
-        m[grow] = True
-    return values, valid
+        neighbours = frontier[:, None] + offsets  # (n, 8)
+        total = np.zeros(len(frontier), np.float32)
+        count = np.zeros(len(frontier), np.float32)
+        for k in range(len(offsets)):
+            nk = neighbours[:, k]
+            m = ok[nk]
+            total += np.where(m, vals[nk], np.float32(0.0))
+            count += m
+        vals[frontier] = total / count
+        ok[frontier] = True
+        mark[neighbours.ravel()] = True
+        frontier = np.flatnonzero(mark & ~ok & inside)
+        mark[:] = False
+    out_vals = vals.reshape(h + 2, pw)[1:-1, 1:-1]
+    out_valid = ok.reshape(h + 2, pw)[1:-1, 1:-1]
+    return np.where(out_valid, out_vals, values.astype(np.float32)).astype(np.float32), out_valid.copy()
 
 
 def grow_mask(mask: np.ndarray, rings: int) -> np.ndarray:

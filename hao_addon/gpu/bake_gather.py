@@ -19,9 +19,10 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.face_chunks import face_chunks, hole_chunk_ranges
 from ..core.plan import BakeInputError, BakePlan
 from . import util
-from .light_view import LightViewBaker, depth_prepass
+from .light_view import LightViewBaker, depth_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
 
 # Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
@@ -101,7 +102,16 @@ class GatherBaker(LightViewBaker):
         self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
         self.gather_prog = gather_shader(plan.settings.weighting == "uniform")
         self._build_texel_list()
-        self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count)
+        self.chunks = None
+        self.depth_batch = self.all_batch
+        if plan.holes is not None:
+            # Light views draw light-facing faces, plus averted ones only near holes: in
+            # Morton order so that those are a few runs (core/face_chunks.py).
+            drawn = np.concatenate([plan.target_positions, plan.occluder_positions])
+            self.chunks = face_chunks(drawn)
+            self.depth_batch = plan_batch(plan, with_occluders=True, order=self.chunks.order)
+        self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
+                          averted_faces_drawn=0, averted_faces_skipped=0)
 
     def _build_texel_list(self) -> None:
         """Count the target's UV-space fragments, allocate the list at that size, fill it."""
@@ -144,20 +154,33 @@ class GatherBaker(LightViewBaker):
 
     def _release(self) -> None:
         self.depth = self.dummy = self.depth_fb = None
+        self.chunks = self.depth_batch = None
         self.entry_position = self.entry_normal = self.entry_texel = self.accum = None
         super()._release()
 
     def run_direction(self, index: int) -> None:
         plan = self.plan
         view = plan.view(index)
-        # Back faces stay in the map even on closed surfaces (plan.depth_map_culls_back_faces):
-        # the texel is tested against the depth at the pixel centre, and near a light-view
-        # silhouette that centre lies on the back side, whose depth is the better estimate
-        # there (without it the torus of tests/test_skip.py bakes 0.0015 too bright).
-        culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
+        # The map must hold the nearest surface along each pixel's ray. Where everything drawn
+        # bounds solids (plan.holes is not None), that is a light-facing face except where the
+        # light looks into a hole: averted faces are drawn only in the chunks there, and the
+        # map is the same as from every face. Ignoring back faces: a ray from a texel meets the
+        # back of exactly the faces that look towards the light, so those are left out.
+        runs: list[tuple[int, int]] = []
+        if plan.settings.ignore_back_faces:
+            batch, culling = self.all_batch, 'FRONT'
+        elif self.chunks is None:
+            batch, culling = self.all_batch, 'NONE'
+        else:
+            batch, culling = self.depth_batch, 'BACK'
+            faces = len(self.chunks.order)
+            runs = hole_chunk_ranges(self.chunks, plan.holes, view.matrix, faces)
+            drawn = sum(count for _, count in runs)
+            self.stats["averted_faces_drawn"] += drawn
+            self.stats["averted_faces_skipped"] += faces - drawn
         with util.scoped_state():
             gpu.state.blend_set('NONE')
-            depth_prepass(self.depth_fb, self.all_batch, view, culling)
+            depth_prepass(self.depth_fb, batch, view, culling, runs)
         if self.entry_count:
             shader = self.gather_prog
             shader.bind()

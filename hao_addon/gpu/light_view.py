@@ -46,16 +46,20 @@ def depth_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_depth",), _depth_info)
 
 
-def plan_batch(plan: BakePlan, with_occluders: bool) -> "gpu.types.GPUBatch":
-    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)."""
+def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None) -> "gpu.types.GPUBatch":
+    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0);
+    order: (F,) face permutation of that list to draw in, or None."""
     ft = len(plan.target_positions)
     fo = len(plan.occluder_positions) if with_occluders else 0
-    pos = np.concatenate([plan.target_positions.reshape(-1, 3), plan.occluder_positions[:fo].reshape(-1, 3)])
-    uv = np.concatenate([plan.target_uvs.reshape(-1, 2), np.zeros((3 * fo, 2), np.float32)])
+    pos = np.concatenate([plan.target_positions, plan.occluder_positions[:fo]])
+    uv = np.concatenate([plan.target_uvs, np.zeros((fo, 3, 2), np.float32)])
     occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
-    face = np.concatenate([np.repeat(plan.target_faces, 3, axis=0), np.repeat(occ_face, 3, axis=0)])
-    assert len(pos) == 3 * (ft + fo)
-    return util.make_batch('TRIS', {"pos": ('F32', pos), "uv": ('F32', uv), "face": ('F32', face)})
+    face = np.concatenate([plan.target_faces, occ_face])
+    assert len(pos) == ft + fo
+    if order is not None:
+        pos, uv, face = pos[order], uv[order], face[order]
+    return util.make_batch('TRIS', {"pos": ('F32', pos.reshape(-1, 3)), "uv": ('F32', uv.reshape(-1, 2)),
+                                    "face": ('F32', np.repeat(face, 3, axis=0))})
 
 
 def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = False) -> None:
@@ -69,9 +73,12 @@ def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = Fals
         shader.uniform_float("tex_size", (map_size, map_size))
 
 
-def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
+def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
+                  averted_runs: list[tuple[int, int]] = ()) -> None:
     """Clear the view's sub-rectangle and draw `batch` depth-only from the light.
 
+    averted_runs: (first face, face count) runs of `batch` whose faces turned away from the
+    light are drawn as well, after the whole batch with `culling` (see GatherBaker).
     Colour writes are masked: llvmpipe then runs its depth-only path. (Never mask colour in
     passes with image atomics: llvmpipe then skips their fragment shaders, side effects and
     all.) Call inside util.scoped_state()."""
@@ -90,6 +97,13 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str) -> None:
         gpu.state.color_mask_set(False, False, False, False)
         bind_light_view(shader, view, 0, prepass=True)
         batch.draw(shader)
+        if averted_runs:
+            gpu.state.face_culling_set('FRONT')  # front = counter-clockwise = facing the light
+            if hasattr(batch, "draw_range"):
+                for first, count in averted_runs:
+                    batch.draw_range(shader, elem_start=3 * first, elem_count=3 * count)
+            else:  # a Blender without GPUBatch.draw_range: every averted face, still exact
+                batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
 
 
