@@ -61,9 +61,9 @@ def test_rebake_with_unchanged_input_is_cached(gpu_context):
 
 
 def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
-    """Everything drawn is closed: the scatter's light-view depth maps draw only light-facing
-    faces (the first surface a light ray meets is always one), and the map equals the one
-    from drawing every face."""
+    """Everything drawn is closed: the scatter's light-view pre-pass draws one side of the
+    faces only (those turned away from the light, see plan.depth_map_culls_back_faces), and
+    the map equals the one from drawing every face."""
     import dataclasses
 
     from hao_addon.core.plan import make_plan

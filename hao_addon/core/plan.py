@@ -60,13 +60,15 @@ class BakePlan:
 
     @property
     def depth_map_culls_back_faces(self) -> bool:
-        """Whether a nearest-surface depth map from a light may skip faces turned away from
-        it: when the user ignores back faces, and, with unlimited distance, when everything
-        drawn is closed (the first surface a light ray meets is then always a light-facing
-        one, so the map is unchanged). With a max distance the back face where a ray enters
-        an occluder can lie within reach while its exit does not, so it must stay. Used by
-        the scatter, which compares a fragment with the map at its own pixel; the gather keeps
-        back faces (see bake_gather.py)."""
+        """Whether the scatter's depth pre-pass may draw one side of the faces only: when the
+        user ignores back faces, and, with unlimited distance, when everything drawn is closed.
+        The scatter then keeps the faces turned *away* from the light (its pre-pass culls
+        'FRONT', front = facing the light): on closed surfaces the first averted face along a
+        pixel's ray lies behind the first light-facing one and in front of whatever that hides,
+        so each fragment's visibility, judged against the map at its own pixel, is unchanged
+        (tests/test_skip.py: within 1e-4 on a torus). With a max distance a face where a ray
+        enters an occluder can lie within reach while its exit does not, so both stay. The
+        gather uses `holes` instead (bake_gather.py)."""
         return self.settings.ignore_back_faces or (self.closed_surfaces and self.settings.max_distance == 0.0)
 
     @property

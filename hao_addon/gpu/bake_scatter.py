@@ -143,6 +143,7 @@ class ScatterBaker(LightViewBaker):
         # Ignoring back faces: a ray from a texel towards the light meets the back of a face
         # exactly when that face looks towards the light, i.e. faces the light camera. So the
         # pre-pass culls FRONT faces; the splat pass draws only light-facing target faces.
+        # Closed surfaces: see plan.depth_map_culls_back_faces.
         culling = 'FRONT' if plan.settings.ignore_back_faces else 'NONE'
         prepass_culling = 'FRONT' if plan.depth_map_culls_back_faces else 'NONE'
         with util.scoped_state():
