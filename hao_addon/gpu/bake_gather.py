@@ -22,7 +22,7 @@ import numpy as np
 from ..core.face_chunks import face_chunks, hole_chunk_ranges
 from ..core.plan import BakeInputError, BakePlan
 from . import util
-from .light_view import LightViewBaker, depth_prepass, plan_batch
+from .light_view import LightViewBaker, depth_prepass
 from .shaders import cached_shader, glsl_source
 
 # Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
@@ -102,16 +102,18 @@ class GatherBaker(LightViewBaker):
         self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
         self.gather_prog = gather_shader(plan.settings.weighting == "uniform")
         self._build_texel_list()
-        self.chunks = None
-        self.depth_batch = self.all_batch
-        if plan.holes is not None:
-            # Light views draw light-facing faces, plus averted ones only near holes: in
-            # Morton order so that those are a few runs (core/face_chunks.py).
-            drawn = np.concatenate([plan.target_positions, plan.occluder_positions])
-            self.chunks = face_chunks(drawn)
-            self.depth_batch = plan_batch(plan, with_occluders=True, order=self.chunks.order)
         self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0)
+
+    def _draw_order(self) -> np.ndarray | None:
+        """Light views draw light-facing faces, plus averted ones only near holes: in Morton
+        order, so that those are a few runs (core/face_chunks.py)."""
+        plan = self.plan
+        self.chunks = None
+        if plan.holes is None:
+            return None
+        self.chunks = face_chunks(np.concatenate([plan.target_positions, plan.occluder_positions]))
+        return self.chunks.order
 
     def _build_texel_list(self) -> None:
         """Count the target's UV-space fragments, allocate the list at that size, fill it."""
@@ -154,7 +156,7 @@ class GatherBaker(LightViewBaker):
 
     def _release(self) -> None:
         self.depth = self.dummy = self.depth_fb = None
-        self.chunks = self.depth_batch = None
+        self.chunks = None
         self.entry_position = self.entry_normal = self.entry_texel = self.accum = None
         super()._release()
 
@@ -168,11 +170,11 @@ class GatherBaker(LightViewBaker):
         # back of exactly the faces that look towards the light, so those are left out.
         runs: list[tuple[int, int]] = []
         if plan.settings.ignore_back_faces:
-            batch, culling = self.all_batch, 'FRONT'
+            culling = 'FRONT'
         elif self.chunks is None:
-            batch, culling = self.all_batch, 'NONE'
+            culling = 'NONE'
         else:
-            batch, culling = self.depth_batch, 'BACK'
+            culling = 'BACK'
             faces = len(self.chunks.order)
             runs = hole_chunk_ranges(self.chunks, plan.holes, view.matrix, faces)
             drawn = sum(count for _, count in runs)
@@ -180,7 +182,7 @@ class GatherBaker(LightViewBaker):
             self.stats["averted_faces_skipped"] += faces - drawn
         with util.scoped_state():
             gpu.state.blend_set('NONE')
-            depth_prepass(self.depth_fb, batch, view, culling, runs)
+            depth_prepass(self.depth_fb, self.all_batch, view, culling, runs)
         if self.entry_count:
             shader = self.gather_prog
             shader.bind()

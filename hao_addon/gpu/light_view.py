@@ -124,12 +124,16 @@ class LightViewBaker(util.GPUPass):
         super().__init__()
         self.plan = plan
         try:
-            self.all_batch = plan_batch(plan, with_occluders=True)
+            self.all_batch = plan_batch(plan, with_occluders=True, order=self._draw_order())
             self.target_batch = plan_batch(plan, with_occluders=False)
             self._allocate()
         except BaseException:
             self.free()
             raise
+
+    def _draw_order(self) -> np.ndarray | None:
+        """(F,) permutation of target + occluder faces for the light-view batch, or None."""
+        return None
 
     def _allocate(self) -> None:
         raise NotImplementedError
