@@ -1,7 +1,52 @@
 /* Shadow-map gather (the comparison of McGraw & Sowers' Table 1): every texel-list entry is
- * tested against this direction's depth map and adds (V w, w), w = weight(omega . n) / S_f.
- * Each invocation owns its entry, so the float sums need no atomics and are summed in
- * direction order, the same on every run. */
+ * tested against the depth maps of VIEWS directions (1 to 4, one dispatch) and adds (V w, w),
+ * w = weight(omega . n) / S_f, for each. Loading an entry and its running sums once for
+ * several directions is what batching saves (llvmpipe: the loads and the store cost more
+ * than the tests). Each invocation owns its entry, so the float sums need no atomics; they
+ * are added one direction at a time in direction order, the same arithmetic as one
+ * direction per dispatch, and the same on every run. */
+
+/* Visibility of `position` from one light view: view_proj maps to clip space, view_info is
+ * (width, height, pixel depth in clip z units, unused). */
+float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 position, float cos_theta)
+{
+  vec3 light_pos = (view_proj * vec4(position, 1.0)).xyz;
+  ivec2 view_size = ivec2(view_info.xy);
+  ivec2 px = ivec2(floor((light_pos.xy * 0.5 + 0.5) * view_info.xy));
+  if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, view_size))) {
+    return 1.0;
+  }
+  /* Slope-scaled bias against shadow acne: a depth-map pixel spans pixel_size, so a surface
+   * tilted by theta changes depth by up to pixel_size * tan(theta) across it. Clamped at
+   * tan = 100 (cos ~ 0.01): steeper directions carry almost no cosine weight, and a lower
+   * clamp let grazing directions shadow open planes (acne of ~1e-3). */
+  float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 100.0);
+  float bias = (1.5 * tan_theta + 0.5) * view_info.z;
+  float depth = light_pos.z * 0.5 + 0.5;
+  return (depth - bias <= texelFetch(depth_tex, px, 0).r) ? 1.0 : 0.0;
+}
+
+/* Adds one view's term to sum when the entry faces that light. */
+#ifdef UNIFORM_WEIGHTING
+#  define GATHER_VIEW(depth_tex, k) \
+    { \
+      float cos_theta = dot(normal, views.omega[k].xyz); \
+      if (cos_theta > 0.0) { \
+        float weight = position.w; \
+        sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
+      } \
+    }
+#else
+#  define GATHER_VIEW(depth_tex, k) \
+    { \
+      float cos_theta = dot(normal, views.omega[k].xyz); \
+      if (cos_theta > 0.0) { \
+        float weight = cos_theta * position.w; \
+        sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
+      } \
+    }
+#endif
+
 void main()
 {
   ivec2 slot = ivec2(gl_GlobalInvocationID.xy);
@@ -10,30 +55,19 @@ void main()
   }
   vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = 1 / S_f */
   vec3 normal = imageLoad(entry_normal, slot).xyz;
-  float cos_theta = dot(normal, omega.xyz);
-  if (cos_theta <= 0.0) {
-    return;
-  }
-#ifdef UNIFORM_WEIGHTING
-  float weight = position.w;
-#else
-  float weight = cos_theta * position.w;
+  vec2 sum = imageLoad(accum, slot).xy;
+  vec2 before = sum;
+  GATHER_VIEW(depth_tex0, 0)
+#if VIEWS > 1
+  GATHER_VIEW(depth_tex1, 1)
 #endif
-  vec3 light_pos = (view_proj * vec4(position.xyz, 1.0)).xyz;
-  vec2 win = (light_pos.xy * 0.5 + 0.5) * vec2(view_size);
-  ivec2 px = ivec2(floor(win));
-  float depth = light_pos.z * 0.5 + 0.5;
-  float visible = 1.0;
-  if (all(greaterThanEqual(px, ivec2(0))) && all(lessThan(px, view_size))) {
-    /* Slope-scaled bias against shadow acne: a depth-map pixel spans pixel_size, so a surface
-     * tilted by theta changes depth by up to pixel_size * tan(theta) across it. Clamped at
-     * tan = 100 (cos ~ 0.01): steeper directions carry almost no cosine weight, and a lower
-     * clamp let grazing directions shadow open planes (acne of ~1e-3). */
-    float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 100.0);
-    float bias = (1.5 * tan_theta + 0.5) * pixel_depth;
-    float stored = texelFetch(depth_tex, px, 0).r;
-    visible = (depth - bias <= stored) ? 1.0 : 0.0;
+#if VIEWS > 2
+  GATHER_VIEW(depth_tex2, 2)
+#endif
+#if VIEWS > 3
+  GATHER_VIEW(depth_tex3, 3)
+#endif
+  if (sum != before) {
+    imageStore(accum, slot, vec4(sum, 0.0, 0.0));
   }
-  vec4 sum = imageLoad(accum, slot);
-  imageStore(accum, slot, sum + vec4(weight * visible, weight, 0.0, 0.0));
 }

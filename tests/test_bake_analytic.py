@@ -138,3 +138,18 @@ def test_sigma_bound_catches_a_two_percent_normalization_error():
     """The tolerance is not vacuous: a 2 % scale error on a map near 0.9 exceeds it."""
     for d in (64, 256, 1024, 4096):
         assert 0.02 * 0.9 > sigma(d) / 8
+
+
+@pytest.mark.parametrize("weighting", ["cosine", "uniform"])
+def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypatch, weighting):
+    """Testing 4 directions per compute dispatch (10 directions: two full batches and a batch
+    of 2 at the end) adds the same terms in the same order as one direction per dispatch."""
+    import hao_addon.gpu.bake_gather as bake_gather
+    plane, sphere = sphere_on_plane()
+    settings = BakeSettings(size=64, directions=10, method="gather", weighting=weighting, margin=0)
+    maps = []
+    for per_dispatch in (4, 1):
+        monkeypatch.setattr(bake_gather, "VIEWS_PER_DISPATCH", per_dispatch)
+        maps.append(bake(plane, [sphere], settings, use_cache=False).ao)
+    assert (maps[0] < 0.99).sum() > 100  # the sphere shadows the plane: the test sees occlusion
+    np.testing.assert_array_equal(maps[0], maps[1])
