@@ -289,3 +289,38 @@ def test_written_files_get_normal_permissions_and_rgba_png_header(tmp_path):
     data = (tmp_path / "rgba.png").read_bytes()
     assert struct.unpack(">IIBB", data[16:26]) == (3, 2, 16, 6)  # 16-bit RGBA
     assert not list(tmp_path.glob("*.part"))
+
+
+def _shifted(a: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
+    out = np.full_like(a, fill)
+    h, w = a.shape
+    out[max(0, -dy):h - max(0, dy), max(0, -dx):w - max(0, dx)] = a[max(0, dy):h - max(0, -dy), max(0, dx):w - max(0, -dx)]
+    return out
+
+
+def test_margin_passes_equal_whole_image_ring_by_ring_versions():
+    """grow_mask (row and column running counts) and dilate (frontier lists) against the
+    plain definitions: ring by ring over whole images, every 8-neighbour shift."""
+    rng = np.random.default_rng(7)
+    offsets = [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx]
+    for shape, density, rings in (((64, 96), 0.01, 5), ((50, 40), 0.2, 3), ((33, 33), 0.0005, 40)):
+        mask = rng.random(shape) < density
+        mask[0, 0] = True
+        values = rng.random(shape).astype(np.float32)
+        grown = mask.copy()
+        vals, ok = np.where(mask, values, 0.0).astype(np.float32), mask.copy()
+        for _ in range(rings):
+            grown = grown | np.any([_shifted(grown, dy, dx, False) for dy, dx in offsets], axis=0)
+            total = np.zeros(shape, np.float32)
+            count = np.zeros(shape, np.float32)
+            for dy, dx in offsets:
+                m = _shifted(ok, dy, dx, False)
+                total += np.where(m, _shifted(vals, dy, dx, 0.0), np.float32(0.0))
+                count += m
+            new = ~ok & (count > 0)
+            vals = np.where(new, total / np.maximum(count, 1), vals)
+            ok = ok | new
+        np.testing.assert_array_equal(seams.grow_mask(mask, rings), grown)
+        out, valid = seams.dilate(values, mask, rings)
+        np.testing.assert_array_equal(valid, ok)
+        np.testing.assert_array_equal(out[valid], vals[valid])

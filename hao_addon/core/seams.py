@@ -43,7 +43,7 @@ def dilate(values: np.ndarray, valid: np.ndarray, rings: int) -> tuple[np.ndarra
     inside = inside.ravel()
     vals.reshape(h + 2, pw)[1:-1, 1:-1] = np.where(valid, values, 0.0)
     ok.reshape(h + 2, pw)[1:-1, 1:-1] = valid
-    offsets = np.array([dy * pw + dx for dy, dx in _OFFSETS])
+    offsets = np.array([dy * pw + dx for dy, dx in _OFFSETS], np.intp)
     okg = ok.reshape(h + 2, pw)
     near = np.zeros_like(okg)
     for dy, dx in _OFFSETS:  # first frontier: whole-image shifts, once
@@ -53,14 +53,14 @@ def dilate(values: np.ndarray, valid: np.ndarray, rings: int) -> tuple[np.ndarra
     for _ in range(rings):
         if len(frontier) == 0:
             break
-        neighbours = frontier[:, None] + offsets  # (n, 8)
-        total = np.zeros(len(frontier), np.float32)
-        count = np.zeros(len(frontier), np.float32)
-        for k in range(len(offsets)):
-            nk = neighbours[:, k]
-            m = ok[nk]
-            total += np.where(m, vals[nk], np.float32(0.0))
-            count += m
+        neighbours = offsets[:, None] + frontier  # (8, n): one contiguous row per offset
+        # Texels not valid yet hold 0, so plain sums over all 8 neighbours are the sums over
+        # the valid ones, added row by row in the neighbour order of the definition.
+        gathered = vals[neighbours]
+        total = gathered[0].copy()
+        for k in range(1, len(offsets)):
+            total += gathered[k]
+        count = np.add.reduce(ok[neighbours], axis=0, dtype=np.float32)
         vals[frontier] = total / count
         ok[frontier] = True
         mark[neighbours.ravel()] = True

@@ -120,7 +120,8 @@ class GatherBaker(LightViewBaker):
         self.views_block = None
         self._build_texel_list()
         self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
-                          averted_faces_drawn=0, averted_faces_skipped=0)
+                          averted_faces_drawn=0, averted_faces_skipped=0,
+                          views_per_dispatch=len(self.depths))
 
     def _draw_order(self) -> np.ndarray | None:
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
