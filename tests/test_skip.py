@@ -63,7 +63,11 @@ def test_rebake_with_unchanged_input_is_cached(gpu_context):
 def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
     """Everything drawn is closed: the scatter's light-view pre-pass draws one side of the
     faces only (those turned away from the light, see plan.depth_map_culls_back_faces), and
-    the map equals the one from drawing every face."""
+    the map equals the one from drawing every face but for a few texels where the light ray
+    leaves an occluder within the depth bias of the fragment (a ray grazing the surface just
+    behind it): there the bias lets through a direction the full map blocks. Over six seeds
+    (pixel-grid jitters): at most 0.1 % of the texels, each by at most one direction's term
+    (1 / S_f <= 4 / D), and a mean change under 1e-4."""
     import dataclasses
 
     from hao_addon.core.plan import make_plan
@@ -72,22 +76,25 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
 
     torus = scenes.torus(1.0, 0.45, (0, 0, 0), 48, 24)
     tilted = TriangleSoup(torus.positions @ np.array([[1, 0, 0], [0, 0.8, 0.6], [0, -0.6, 0.8]]), torus.uvs)
-    method = "scatter"
-    plan = make_plan(tilted, [], BakeSettings(size=128, directions=32, margin=0, method=method))
-    assert plan.closed_surfaces and plan.depth_map_culls_back_faces and plan.stats["closed_surfaces"]
-    maps = []
-    for p in (plan, dataclasses.replace(plan, closed_surfaces=False)):
-        baker = baker_for(method)(p)
-        try:
-            for i in range(p.settings.directions):
-                baker.run_direction(i)
-            maps.append(finalize_map(*baker.accumulated(), 0))
-        finally:
-            baker.free()
-    (culled, covered, _), (full, covered_full, _) = maps
-    np.testing.assert_array_equal(covered, covered_full)
-    assert 0.3 < culled[covered].min() and culled[covered].mean() < 0.97  # the hole shades the inner ring
-    assert np.abs(culled - full)[covered].max() < 1e-4
+    method, directions = "scatter", 32
+    for seed in range(6):
+        plan = make_plan(tilted, [], BakeSettings(size=128, directions=directions, margin=0, method=method, seed=seed))
+        assert plan.closed_surfaces and plan.depth_map_culls_back_faces and plan.stats["closed_surfaces"]
+        maps = []
+        for p in (plan, dataclasses.replace(plan, closed_surfaces=False)):
+            baker = baker_for(method)(p)
+            try:
+                for i in range(p.settings.directions):
+                    baker.run_direction(i)
+                maps.append(finalize_map(*baker.accumulated(), 0))
+            finally:
+                baker.free()
+        (culled, covered, _), (full, covered_full, _) = maps
+        np.testing.assert_array_equal(covered, covered_full)
+        assert 0.3 < culled[covered].min() and culled[covered].mean() < 0.97  # the hole shades the inner ring
+        diff = (culled - full)[covered]
+        assert (np.abs(diff) > 1e-4).mean() <= 1e-3, seed
+        assert np.abs(diff).max() <= 4.0 / directions and abs(diff.mean()) < 1e-4, seed
     # An open occluder (a plane) or a max distance keeps every face in the depth maps.
     plane = scenes.grid_plane(4.0, 4, z=-0.5)
     assert not make_plan(tilted, [plane], BakeSettings(size=64, directions=8)).depth_map_culls_back_faces

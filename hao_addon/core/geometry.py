@@ -39,10 +39,11 @@ def face_normals_areas(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     The winding is counter-clockwise: n = (b - a) x (c - a).
     """
     a, b, c = positions[:, 0], positions[:, 1], positions[:, 2]
-    cross = np.cross(b - a, c - a)
-    length = np.linalg.norm(cross, axis=1)
+    ab, ac = b - a, c - a
+    cross = np.cross(ab, ac)
+    length = np.sqrt(np.einsum("ij,ij->i", cross, cross))
     # Relative threshold: an area tiny against the triangle's own edge lengths is noise.
-    edge = np.maximum(np.max(np.abs(np.stack([b - a, c - a], 1)), axis=(1, 2)), 1e-300)
+    edge = np.maximum(np.maximum(np.abs(ab).max(axis=1), np.abs(ac).max(axis=1)), 1e-300)
     valid = length > 1e-12 * edge * edge
     normals = np.zeros_like(cross)
     normals[valid] = cross[valid] / length[valid, None]
@@ -62,7 +63,8 @@ def bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre = 0.5 * (lo + hi)
-    radius = float(np.sqrt(((pts - centre) ** 2).sum(axis=1).max()))
+    offset = pts - centre
+    radius = float(np.sqrt(np.einsum("ij,ij->i", offset, offset).max()))  # einsum: no (n, 3) temporaries
     return centre, radius
 
 

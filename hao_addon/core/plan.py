@@ -65,8 +65,10 @@ class BakePlan:
         The scatter then keeps the faces turned *away* from the light (its pre-pass culls
         'FRONT', front = facing the light): on closed surfaces the first averted face along a
         pixel's ray lies behind the first light-facing one and in front of whatever that hides,
-        so each fragment's visibility, judged against the map at its own pixel, is unchanged
-        (tests/test_skip.py: within 1e-4 on a torus). With a max distance a face where a ray
+        so each fragment's visibility, judged against the map at its own pixel, is unchanged,
+        except where the ray leaves an occluder within the depth bias of the fragment (grazing
+        just behind it), which the bias then lets through (tests/test_skip.py: 0 to 12 of 16k
+        texels of a torus, each by at most one direction's term). With a max distance a face where a ray
         enters an occluder can lie within reach while its exit does not, so both stay. The
         gather uses `holes` instead (bake_gather.py)."""
         return self.settings.ignore_back_faces or (self.closed_surfaces and self.settings.max_distance == 0.0)
@@ -78,9 +80,22 @@ class BakePlan:
     def view(self, index: int) -> OrthoView:
         """The light view of direction `index`, with a deterministic sub-pixel jitter."""
         omega = self.directions[index]
-        jitter = np.random.default_rng((self.settings.seed, index)).random(2)
+        jitter = pixel_jitter(self.settings.seed, index)
         c, r = self.drawn_sphere
         return fit_view(omega, self.target_points, float(omega @ c) + r, self.pixel_size, jitter, self.max_view_side)
+
+
+# The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets
+# that cover the unit square evenly in any run of views, at no cost (seeding a numpy
+# generator per view took 0.27 ms, 3 % of a light view).
+_PLASTIC = 1.324717957244746
+_R2_STEP = np.array([1.0 / _PLASTIC, 1.0 / _PLASTIC**2])
+
+
+def pixel_jitter(seed: int, index: int) -> np.ndarray:
+    """(2,) sub-pixel offset in [0, 1) of light view `index` of a bake with `seed`."""
+    start = np.array([0.5, 0.5]) + (seed % 1_000_003) * np.array([0.7548776662466927, 0.5698402909980532])
+    return np.mod(start + index * _R2_STEP, 1.0)
 
 
 def _check_finite(soup: TriangleSoup) -> None:
