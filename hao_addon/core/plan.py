@@ -15,7 +15,7 @@ from .directions import bake_directions
 from .geometry import TriangleSoup, bounding_sphere, face_normals_areas, surface_holes, uv_areas, weld
 from .normalization import face_normalizers
 from .settings import BakeSettings
-from .views import OrthoView, fit_view
+from .views import OrthoView, fit_views
 
 # The light view never exceeds this many pixels per side (GPU limit is checked separately);
 # at 8192^2 one RGBA32F view buffer takes 1 GiB.
@@ -79,10 +79,15 @@ class BakePlan:
 
     def view(self, index: int) -> OrthoView:
         """The light view of direction `index`, with a deterministic sub-pixel jitter."""
-        omega = self.directions[index]
-        jitter = pixel_jitter(self.settings.seed, index)
+        return self.views([index])[0]
+
+    def views(self, indices: list[int]) -> list[OrthoView]:
+        """The light views of several directions, fitted together (the same views as view())."""
+        omegas = self.directions[list(indices)]
         c, r = self.drawn_sphere
-        return fit_view(omega, self.target_points, float(omega @ c) + r, self.pixel_size, jitter, self.max_view_side)
+        reaches = [float(omega @ c) + r for omega in omegas]
+        jitters = np.array([pixel_jitter(self.settings.seed, i) for i in indices]).reshape(-1, 2)
+        return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side)
 
 
 # The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets

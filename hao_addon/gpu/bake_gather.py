@@ -19,7 +19,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.face_chunks import face_chunks, hole_chunk_ranges
+from ..core.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.plan import BakeInputError, BakePlan
 from . import util
 from .light_view import LightViewBaker, depth_prepass
@@ -128,10 +128,19 @@ class GatherBaker(LightViewBaker):
         order, so that those are a few runs (core/face_chunks.py)."""
         plan = self.plan
         self.chunks = None
+        self.hole_runs: dict[int, list[tuple[int, int]]] = {}
         if plan.holes is None:
             return None
         self.chunks = face_chunks(np.concatenate([plan.target_positions, plan.occluder_positions]))
         return self.chunks.order
+
+    def _views_fitted(self, indices: list[int], views: list) -> None:
+        """Hole runs (core/face_chunks.py) of a batch of views, found together."""
+        self.hole_runs = {}
+        if self.chunks is not None and not self.plan.settings.ignore_back_faces:
+            runs = hole_chunk_ranges_many(self.chunks, self.plan.holes, np.stack([v.matrix for v in views]),
+                                          len(self.chunks.order))
+            self.hole_runs = dict(zip(indices, runs))
 
     def _build_texel_list(self) -> None:
         """Count the target's UV-space fragments, allocate the list at that size, fill it."""
@@ -181,7 +190,7 @@ class GatherBaker(LightViewBaker):
 
     def run_direction(self, index: int) -> None:
         plan = self.plan
-        view = plan.view(index)
+        view = self.view(index)
         # The map must hold the nearest surface along each pixel's ray. Where everything drawn
         # bounds solids (plan.holes is not None), that is a light-facing face except where the
         # light looks into a hole: averted faces are drawn only in the chunks there, and the
@@ -195,7 +204,7 @@ class GatherBaker(LightViewBaker):
         else:
             culling = 'BACK'
             faces = len(self.chunks.order)
-            runs = hole_chunk_ranges(self.chunks, plan.holes, view.matrix, faces)
+            runs = self.hole_runs[index]
             drawn = sum(count for _, count in runs)
             self.stats["averted_faces_drawn"] += drawn
             self.stats["averted_faces_skipped"] += faces - drawn

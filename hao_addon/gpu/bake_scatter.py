@@ -138,7 +138,7 @@ class ScatterBaker(LightViewBaker):
     def run_direction(self, index: int) -> None:
         """Render light view `index` and splat its target fragments into the accumulators."""
         plan = self.plan
-        view = plan.view(index)
+        view = self.view(index)
         w, h = view.width, view.height
         # Ignoring back faces: a ray from a texel towards the light meets the back of a face
         # exactly when that face looks towards the light, i.e. faces the light camera. So the
