@@ -240,7 +240,7 @@ def test_face_chunks_and_hole_runs_are_conservative():
     past the hole) falls in a returned run; the runs cover far fewer faces than all."""
     from hao_addon.core import scenes
     from hao_addon.core.directions import bake_directions
-    from hao_addon.core.face_chunks import CHUNK_FACES, face_chunks, hole_chunk_ranges
+    from hao_addon.core.face_chunks import CHUNK_FACES, face_chunks, hole_chunk_ranges, hole_chunk_ranges_many
     from hao_addon.core.geometry import face_normals_areas, surface_holes
     from hao_addon.core.views import fit_view
     torus = scenes.torus(1.0, 0.4, (0, 0, 0), 96, 48).positions
@@ -275,6 +275,11 @@ def test_face_chunks_and_hole_runs_are_conservative():
             needed = meets & (normals @ omega < 0)
             assert in_run[needed].all()
     assert drawn_total < 0.25 * 32 * len(holed)
+    # Many views at once (what the gather uses) give each view's own runs.
+    views = [fit_view(omega, points, None, 0.01, np.zeros(2), 4096) for omega in bake_directions(16, 6)]
+    matrices = np.stack([view.matrix for view in views])
+    assert hole_chunk_ranges_many(chunks, holes, matrices, len(holed)) == \
+        [hole_chunk_ranges(chunks, holes, m, len(holed)) for m in matrices]
 
 
 def test_written_files_get_normal_permissions_and_rgba_png_header(tmp_path):
