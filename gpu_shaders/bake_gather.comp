@@ -49,10 +49,13 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
 
 void main()
 {
-  ivec2 slot = ivec2(gl_GlobalInvocationID.xy);
-  if (slot.y * LIST_WIDTH + slot.x >= entry_count) {
+  /* This dispatch covers entries first_entry .. entry_end - 1 (a run of normal bins that can
+   * face one of its views, core/normal_bins.py), LIST_WIDTH per grid row. */
+  int index = first_entry + int(gl_GlobalInvocationID.y) * LIST_WIDTH + int(gl_GlobalInvocationID.x);
+  if (index >= entry_end) {
     return;
   }
+  ivec2 slot = ivec2(index % LIST_WIDTH, index / LIST_WIDTH);
   vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = 1 / S_f */
   vec3 normal = imageLoad(entry_normal, slot).xyz;
   vec2 sum = imageLoad(accum, slot).xy;

@@ -1,8 +1,10 @@
-/* Appends one entry per fragment (texel centre x face) to the texel list. The count variant
- * only counts, so the list can be allocated at its exact size; the fill variant stores the
- * entries. Overlapping UV islands give one entry per island, and their sums average later.
- * Entry order follows the rasterizer's threads; every entry is processed independently, so
- * the order does not change any result. */
+/* Appends one entry per fragment (texel centre x face) to the texel list, grouped by the
+ * face's normal bin. The count variant counts the entries of each bin, so the list can be
+ * allocated at its exact size with each bin's range known; the fill variant stores every
+ * entry in its bin's range (bin_start holds the ranges' first entries, as float bits).
+ * Overlapping UV islands give one entry per island, and their sums average later. Entry
+ * order within a bin follows the rasterizer's threads; every entry is processed on its own,
+ * so the order does not change any result. */
 void main()
 {
   /* llvmpipe skips fragment shaders with side effects when no colour is written. */
@@ -10,8 +12,9 @@ void main()
   if (face_data.w <= 0.0) {
     return; /* a face no direction sees (or of zero area) contributes nothing */
   }
-  uint index = imageAtomicAdd(entry_count, ivec2(0, 0), 1u);
+  uint index = imageAtomicAdd(bin_count, ivec2(face_bin, 0), 1u);
 #ifdef FILL
+  index += floatBitsToUint(imageLoad(bin_start, ivec2(face_bin, 0)).r);
   if (index >= uint(capacity)) {
     return;
   }

@@ -153,3 +153,22 @@ def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypat
         maps.append(bake(plane, [sphere], settings, use_cache=False).ao)
     assert (maps[0] < 0.99).sum() > 100  # the sphere shadows the plane: the test sees occlusion
     np.testing.assert_array_equal(maps[0], maps[1])
+
+
+def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, monkeypatch):
+    """Dispatching only the texel-list entries whose normal bin can face a batch's views
+    (core/normal_bins.py) gives the same map as testing every entry, and skips entries."""
+    import hao_addon.gpu.bake_gather as bake_gather
+    from hao_addon.bake import bake_steps
+    sphere = scenes.uv_sphere(1.0, (0.0, 0.0, 1.0), 48, 24)  # normals all round: bins to skip
+    settings = BakeSettings(size=64, directions=32, method="gather", margin=0)
+    maps, stats = [], []
+    for binning in (True, False):
+        monkeypatch.setattr(bake_gather, "NORMAL_BINNING", binning)
+        res = bake(sphere, [scenes.grid_plane(8.0, 16)], settings, use_cache=False)
+        maps.append(res.ao)
+        stats.append(res.stats)
+    np.testing.assert_array_equal(maps[0], maps[1])
+    assert (maps[0] < 0.9).sum() > 50  # the plane shades the sphere's underside
+    assert stats[0]["texel_tests_skipped"] > 0.1 * (stats[0]["texel_tests"] + stats[0]["texel_tests_skipped"])
+    assert stats[1]["texel_tests_skipped"] == 0

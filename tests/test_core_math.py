@@ -329,3 +329,31 @@ def test_margin_passes_equal_whole_image_ring_by_ring_versions():
         out, valid = seams.dilate(values, mask, rings)
         np.testing.assert_array_equal(valid, ok)
         np.testing.assert_array_equal(out[valid], vals[valid])
+
+
+def test_normal_bin_cones_hold_every_face_a_view_can_face():
+    """A batch of views tests only the bins whose cone reaches one of their hemispheres: every
+    face with n . omega > 0 for some omega of the batch must be in such a bin."""
+    from hao_addon.core.directions import bake_directions
+    from hao_addon.core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
+    rng = np.random.default_rng(11)
+    normals = rng.normal(size=(20000, 3))
+    normals[:2000] = [0.0, 0.0, 1.0]  # many identical normals: a zero-width cone
+    normals[2000:2010] = 0.0  # degenerate faces: unused
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
+    used = length[:, 0] > 0
+    bins = normal_bins(normals)
+    assert bins.min() >= 0 and bins.max() < BIN_COUNT
+    axis, threshold = bin_cones(normals, bins, used)
+    directions = bake_directions(64, 2)
+    order = proximity_order(directions)
+    assert np.array_equal(np.sort(order), np.arange(64))
+    skipped = 0
+    for start in range(0, 64, 4):
+        omegas = directions[order[start:start + 4]]
+        needed = bins_facing(axis, threshold, omegas)
+        facing = used & ((normals @ omegas.T) > 0.0).any(axis=1)
+        assert needed[bins[facing]].all()
+        skipped += (~needed[bins[used]]).sum()
+    assert skipped > 0.1 * 16 * used.sum()  # nearby directions per batch: bins are skipped (19 % here)

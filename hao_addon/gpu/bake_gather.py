@@ -20,9 +20,10 @@ import gpu
 import numpy as np
 
 from ..core.face_chunks import face_chunks, hole_chunk_ranges_many
+from ..core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
 from ..core.plan import BakeInputError, BakePlan
 from . import util
-from .light_view import LightViewBaker, depth_prepass
+from .light_view import LightViewBaker, depth_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
 
 # Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
@@ -36,13 +37,15 @@ def _texel_list_info(fill: bool) -> "gpu.types.GPUShaderCreateInfo":
     iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}")
     iface.smooth('VEC3', "world_pos")
     iface.flat('VEC4', "face_data")
+    iface.flat('INT', "face_bin")
     info = gpu.types.GPUShaderCreateInfo()
     info.vertex_in(0, 'VEC3', "pos")
     info.vertex_in(1, 'VEC2', "uv")
     info.vertex_in(2, 'VEC4', "face")
+    info.vertex_in(3, 'FLOAT', "bin")
     info.vertex_out(iface)
     info.fragment_out(0, 'VEC4', "list_out")
-    info.image(0, 'R32UI', 'UINT_2D', "entry_count", qualifiers={'READ', 'WRITE'})
+    info.image(0, 'R32UI', 'UINT_2D', "bin_count", qualifiers={'READ', 'WRITE'})
     if fill:
         info.define("FILL", "1")
         info.define("LIST_WIDTH", str(LIST_WIDTH))
@@ -50,6 +53,7 @@ def _texel_list_info(fill: bool) -> "gpu.types.GPUShaderCreateInfo":
         info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'WRITE'})
         info.image(2, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'WRITE'})
         info.image(3, 'R32UI', 'UINT_2D', "entry_texel", qualifiers={'WRITE'})
+        info.image(4, 'R32F', 'FLOAT_2D', "bin_start", qualifiers={'READ'})
     info.vertex_source(glsl_source("bake_texel_list.vert"))
     info.fragment_source(glsl_source("bake_texel_list.frag"))
     return info
@@ -65,6 +69,9 @@ def texel_list_shader(fill: bool) -> "gpu.types.GPUShader":
 # direction per dispatch.
 VIEWS_PER_DISPATCH = 4
 MAX_BATCHED_VIEW_SIDE = 2048
+# Dispatch only the entries of normal bins that can face a view (False: every entry; the
+# results are the same, tests/test_bake_analytic.py).
+NORMAL_BINNING = True
 
 
 def views_per_dispatch(plan: BakePlan) -> int:
@@ -78,7 +85,8 @@ def _gather_info(uniform: bool, views: int) -> "gpu.types.GPUShaderCreateInfo":
     info.define("VIEWS", str(views))
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
-    info.push_constant('INT', "entry_count")
+    info.push_constant('INT', "first_entry")
+    info.push_constant('INT', "entry_end")
     info.typedef_source(glsl_source("bake_gather_views.glsl"))
     info.uniform_buf(0, "GatherViews", "views")
     for k in range(views):
@@ -118,10 +126,12 @@ class GatherBaker(LightViewBaker):
                           for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
         self.views_block = None
+        # Batches of nearby directions face nearly the same normal bins (core/normal_bins.py).
+        self.direction_order = proximity_order(plan.directions)
         self._build_texel_list()
         self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
-                          views_per_dispatch=len(self.depths))
+                          views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0)
 
     def _draw_order(self) -> np.ndarray | None:
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
@@ -134,6 +144,13 @@ class GatherBaker(LightViewBaker):
         self.chunks = face_chunks(np.concatenate([plan.target_positions, plan.occluder_positions]))
         return self.chunks.order
 
+    def _target_batch(self) -> "gpu.types.GPUBatch":
+        """The target with each face's normal bin, and the cones of the bins' normals."""
+        faces = self.plan.target_faces
+        bins = normal_bins(faces[:, :3])
+        self.bin_axis, self.bin_threshold = bin_cones(faces[:, :3], bins, faces[:, 3] > 0.0)
+        return plan_batch(self.plan, with_occluders=False, face_bins=bins)
+
     def _views_fitted(self, indices: list[int], views: list) -> None:
         """Hole runs (core/face_chunks.py) of a batch of views, found together."""
         self.hole_runs = {}
@@ -143,9 +160,10 @@ class GatherBaker(LightViewBaker):
             self.hole_runs = dict(zip(indices, runs))
 
     def _build_texel_list(self) -> None:
-        """Count the target's UV-space fragments, allocate the list at that size, fill it."""
+        """Count the target's UV-space fragments per normal bin, allocate the list at that
+        size with each bin's entries together, fill it."""
         size = self.plan.settings.size
-        counter = gpu.types.GPUTexture((1, 1), format='R32UI')
+        counter = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32UI')
         uv_target = gpu.types.GPUTexture((size, size), format='R8')
         uv_fb = gpu.types.GPUFrameBuffer(color_slots=uv_target)
 
@@ -154,18 +172,21 @@ class GatherBaker(LightViewBaker):
             with util.scoped_state(), uv_fb.bind():
                 util.set_overlay_pass_state(size, size)
                 shader.bind()
-                shader.image("entry_count", counter)
+                shader.image("bin_count", counter)
                 if shader is fill:
                     shader.uniform_int("capacity", count)
                     shader.image("entry_position", self.entry_position)
                     shader.image("entry_normal", self.entry_normal)
                     shader.image("entry_texel", self.entry_texel)
+                    shader.image("bin_start", bin_start)
                 self.target_batch.draw(shader)
             util.image_barrier()
 
         fill = texel_list_shader(True)
         draw(texel_list_shader(False))
-        count = int(util.texture_to_numpy(counter, np.uint32).ravel()[0])
+        per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
+        count = int(per_bin.sum())
+        self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
         self.entry_count = count
         rows = max(1, -(-count // LIST_WIDTH))
         if rows > gpu.capabilities.max_texture_size_get():
@@ -179,7 +200,27 @@ class GatherBaker(LightViewBaker):
         self.entry_texel = gpu.types.GPUTexture(shape, format='R32UI')
         self.accum = gpu.types.GPUTexture(shape, format='RG32F')
         self.accum.clear(format='FLOAT', value=(0.0, 0.0))
+        # Only FLOAT buffers upload: the uint32 starts travel as float bits (floatBitsToUint).
+        starts = self.bin_first[:-1].astype(np.uint32).view(np.float32)
+        bin_start = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32F',
+                                         data=gpu.types.Buffer('FLOAT', BIN_COUNT, starts))
         draw(fill)
+
+    def _entry_runs(self, omegas: np.ndarray) -> list[tuple[int, int]]:
+        """(first entry, end entry) runs of the bins that can face one of omegas (k, 3)."""
+        if NORMAL_BINNING:
+            needed = bins_facing(self.bin_axis, self.bin_threshold, omegas)
+        else:
+            needed = np.ones(BIN_COUNT, bool)
+        needed |= self.bin_first[1:] == self.bin_first[:-1]  # empty bins join their neighbours' runs
+        picked = np.flatnonzero(needed)
+        if len(picked) == 0:
+            return []
+        breaks = np.flatnonzero(np.diff(picked) > 1)
+        first = np.concatenate([picked[:1], picked[breaks + 1]])
+        last = np.concatenate([picked[breaks], picked[-1:]])
+        runs = [(int(self.bin_first[a]), int(self.bin_first[b + 1])) for a, b in zip(first, last)]
+        return [(a, b) for a, b in runs if b > a]
 
     def _release(self) -> None:
         self.depths = self.depth_fbs = self.dummy = self.views_block = None
@@ -233,15 +274,25 @@ class GatherBaker(LightViewBaker):
         self.views_block = gpu.types.GPUUniformBuf(block)  # kept until the next dispatch replaces it
         shader = gather_shader(self.plan.settings.weighting == "uniform", len(views))
         shader.bind()
-        shader.uniform_int("entry_count", self.entry_count)
         shader.uniform_block("views", self.views_block)
         for k in range(len(views)):
             shader.uniform_sampler(f"depth_tex{k}", self.depths[k])
         shader.image("entry_position", self.entry_position)
         shader.image("entry_normal", self.entry_normal)
         shader.image("accum", self.accum)
-        gpu.compute.dispatch(shader, LIST_WIDTH // GROUP_SIZE, self.entry_position.height, 1)
+        # On llvmpipe an invocation costs its whole shader whether or not its entry faces a
+        # view, so entries of bins that face none of these views are not dispatched at all.
+        tested = 0
+        for first, end in self._entry_runs(np.array([view.omega for view in views])):
+            shader.uniform_int("first_entry", first)
+            shader.uniform_int("entry_end", end)
+            count = end - first
+            groups_x = -(-min(count, LIST_WIDTH) // GROUP_SIZE)
+            gpu.compute.dispatch(shader, groups_x, -(-count // LIST_WIDTH), 1)
+            tested += count
         gpu.shader.unbind()
+        self.stats["texel_tests"] += tested * len(views)
+        self.stats["texel_tests_skipped"] += (self.entry_count - tested) * len(views)
 
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
         """(numerator, denominator), each (size, size) float64: the entries summed per texel."""

@@ -46,9 +46,11 @@ def depth_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_depth",), _depth_info)
 
 
-def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None) -> "gpu.types.GPUBatch":
+def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None,
+               face_bins: np.ndarray | None = None) -> "gpu.types.GPUBatch":
     """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0);
-    order: (F,) face permutation of that list to draw in, or None."""
+    order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
+    face normal bins, added as the float attribute "bin" (target alone only)."""
     ft = len(plan.target_positions)
     fo = len(plan.occluder_positions) if with_occluders else 0
     pos = np.concatenate([plan.target_positions, plan.occluder_positions[:fo]])
@@ -58,8 +60,12 @@ def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = 
     assert len(pos) == ft + fo
     if order is not None:
         pos, uv, face = pos[order], uv[order], face[order]
-    return util.make_batch('TRIS', {"pos": ('F32', pos.reshape(-1, 3)), "uv": ('F32', uv.reshape(-1, 2)),
-                                    "face": ('F32', np.repeat(face, 3, axis=0))})
+    attrs = {"pos": ('F32', pos.reshape(-1, 3)), "uv": ('F32', uv.reshape(-1, 2)),
+             "face": ('F32', np.repeat(face, 3, axis=0))}
+    if face_bins is not None:
+        assert fo == 0 and order is None
+        attrs["bin"] = ('F32', np.repeat(np.asarray(face_bins, np.float32), 3))
+    return util.make_batch('TRIS', attrs)
 
 
 def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = False) -> None:
@@ -127,9 +133,11 @@ class LightViewBaker(util.GPUPass):
         super().__init__()
         self.plan = plan
         self._views: dict[int, OrthoView] = {}
+        # Direction of each step (run_direction(step)); subclasses may reorder.
+        self.direction_order = np.arange(plan.settings.directions)
         try:
             self.all_batch = plan_batch(plan, with_occluders=True, order=self._draw_order())
-            self.target_batch = plan_batch(plan, with_occluders=False)
+            self.target_batch = self._target_batch()
             self._allocate()
         except BaseException:
             self.free()
@@ -139,18 +147,21 @@ class LightViewBaker(util.GPUPass):
         """(F,) permutation of target + occluder faces for the light-view batch, or None."""
         return None
 
-    def view(self, index: int) -> OrthoView:
-        """plan.view(index), fitted VIEW_PREFETCH directions at a time (plan.views): per view,
-        numpy's call overhead was most of the fit's 0.5 ms on the bunny."""
-        if index not in self._views:
-            count = self.plan.settings.directions
-            indices = list(range(index, min(index + VIEW_PREFETCH, count)))
-            fitted = self.plan.views(indices)
-            self._views = dict(zip(indices, fitted))
-            self._views_fitted(indices, fitted)
-        return self._views[index]
+    def _target_batch(self) -> "gpu.types.GPUBatch":
+        return plan_batch(self.plan, with_occluders=False)
 
-    def _views_fitted(self, indices: list[int], views: list[OrthoView]) -> None:
+    def view(self, step: int) -> OrthoView:
+        """The light view of step `step` (direction direction_order[step]), fitted
+        VIEW_PREFETCH steps at a time (plan.views): per view, numpy's call overhead was most
+        of the fit's 0.5 ms on the bunny."""
+        if step not in self._views:
+            steps = list(range(step, min(step + VIEW_PREFETCH, self.plan.settings.directions)))
+            fitted = self.plan.views([int(self.direction_order[s]) for s in steps])
+            self._views = dict(zip(steps, fitted))
+            self._views_fitted(steps, fitted)
+        return self._views[step]
+
+    def _views_fitted(self, steps: list[int], views: list[OrthoView]) -> None:
         """Hook: per-view work that is cheaper for a batch of views (called from view())."""
 
     def _allocate(self) -> None:
