@@ -95,7 +95,7 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
         gpu.state.viewport_set(0, 0, w, h)
         gpu.state.scissor_set(0, 0, w, h)
         gpu.state.scissor_test_set(True)
-        fb.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+        fb.clear(depth=1.0)  # the colour target is never written (masked) nor read
         gpu.state.scissor_test_set(False)
         gpu.state.depth_test_set('LESS')
         gpu.state.depth_mask_set(True)
