@@ -12,7 +12,8 @@ bias. Cycles bakes the same UV layout with flat shading and a 1e6 AO distance, s
 cosine-weighted, unlimited-distance accessibility on face normals. A triangle-count sweep
 (UV spheres, 2k to 500k triangles) checks how cost scales with geometry. Each method bakes
 once untimed first (shader compilation; Cycles' first-bake set-up), then every timed run is
-one bake as a user would run it.
+one bake as a user would run it. Both bakers run with margin 0 (no island growth; the error is
+measured inside the islands).
 Writes bake_bench.json and bake_bench.png into the output folder.
 """
 from __future__ import annotations
@@ -119,11 +120,13 @@ def hao_runs(soup, size, method, directions_list, view_samples=2.0):
     out = []
     # Warm-up (not timed): shader compilation (LLVM JIT, ~0.1 s per variant) happens once per
     # session, and Cycles gets the same courtesy in cycles_bake.
-    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples), use_cache=False)
+    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0),
+         use_cache=False)
     for d in directions_list:
         t = time.perf_counter()
-        res = bake(soup, [], BakeSettings(size=size, directions=d, method=method, view_samples=view_samples),
-                   use_cache=False)
+        # margin=0 as in cycles_bake: neither grows islands (error is measured inside them).
+        res = bake(soup, [], BakeSettings(size=size, directions=d, method=method, view_samples=view_samples,
+                                          margin=0), use_cache=False)
         dt = time.perf_counter() - t
         out.append((d, dt, res.ao))
         print(f"  {method:7s} {d:5d} dirs: {dt:7.2f} s", flush=True)

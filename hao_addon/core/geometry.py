@@ -60,11 +60,13 @@ def uv_areas(uvs: np.ndarray) -> np.ndarray:
 def bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
     """Centre (3,) and radius of a sphere enclosing points (n, 3): the box centre and
     the farthest point from it (within sqrt(3) of optimal, always enclosing)."""
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    # (3, n) rows: reductions along contiguous rows are several times faster than down the
+    # columns of an (n, 3) array (18 -> ~5 ms for the bunny's 208k corners).
+    rows = np.asarray(points, dtype=np.float64).reshape(-1, 3).T.copy()
+    lo, hi = rows.min(axis=1), rows.max(axis=1)
     centre = 0.5 * (lo + hi)
-    offset = pts - centre
-    radius = float(np.sqrt(np.einsum("ij,ij->i", offset, offset).max()))  # einsum: no (n, 3) temporaries
+    d = rows - centre[:, None]
+    radius = float(np.sqrt((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max()))
     return centre, radius
 
 
@@ -89,14 +91,17 @@ def weld(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return first, inverse
 
 
-def _welded_triangles(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices (V, 3) float64, triangles (F, 3) int64): corners welded when bit-identical."""
+def _welded_triangles(positions: np.ndarray, welded: tuple[np.ndarray, np.ndarray] | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (V, 3) float64, triangles (F, 3) int64): corners welded when bit-identical.
+    welded: weld() of these corners when the caller has it already."""
     corners = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-    first, vertex = weld(corners)
+    first, vertex = weld(corners) if welded is None else welded
     return corners[first], vertex.reshape(-1, 3).astype(np.int64)
 
 
-def surface_holes(positions: np.ndarray) -> list[np.ndarray] | None:
+def surface_holes(positions: np.ndarray, welded: tuple[np.ndarray, np.ndarray] | None = None
+                  ) -> list[np.ndarray] | None:
     """The holes of (F, 3, 3) triangles that bound solids: one (k, 3) float64 array of
     boundary-loop vertices per hole, [] for closed surfaces, None when the triangles do not
     bound solids even after capping their holes.
@@ -112,10 +117,11 @@ def surface_holes(positions: np.ndarray) -> list[np.ndarray] | None:
     equals the map of the light-facing faces alone except inside the light-view outline of a
     hole (the cap lies in the convex hull of its loop): faces turned away from the light are
     needed only there (on llvmpipe they cost about 40 % of a light view).
+    welded: weld() of the corners, when the caller has it already.
     """
     if len(np.asarray(positions).reshape(-1, 9)) == 0:
         return None
-    verts, tri = _welded_triangles(positions)
+    verts, tri = _welded_triangles(positions, welded)
     a = tri.ravel()
     b = np.roll(tri, -1, axis=1).ravel()
     if (a == b).any():  # a collapsed edge: no consistent orientation to speak of

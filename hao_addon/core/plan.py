@@ -180,14 +180,16 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
     drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
+    target_weld = weld(t_pos.reshape(-1, 3))
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
     holes = None
     if settings.max_distance == 0.0 and not settings.ignore_back_faces:
-        holes = surface_holes(drawn.reshape(-1, 3, 3))
+        # Without occluders the drawn corners are the target's: one weld serves both.
+        holes = surface_holes(drawn.reshape(-1, 3, 3), target_weld if len(o_pos) == 0 else None)
     closed = holes == []
     drawn_sphere = bounding_sphere(drawn)
     # Distinct corners: a light view's window is fitted to them (shared corners once).
-    target_points = t_pos.reshape(-1, 3)[weld(t_pos.reshape(-1, 3))[0]]
+    target_points = t_pos.reshape(-1, 3)[target_weld[0]]
 
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
