@@ -8,11 +8,13 @@ area average, no stretch correction needed), shadow-map bias (a slope-scaled off
 contact occlusion thinner than a few light-view pixels), and unlimited distance only.
 
 The target is rasterized in UV space once per bake, into a compact texel list (surface point,
-face, texel of every covered texel centre), and each direction's test is a compute pass over
+face, texel of every covered texel centre), and the directions' tests are compute passes over
 that list. Rasterizing the target in UV space again for every direction gives the same
 fragments, but on llvmpipe a draw's per-triangle cost (about 0.25 us, even for triangles
 that are clipped away) made it half of each direction's time on a 70k-triangle mesh.
-Sums are float32 per entry in direction order (deterministic), float64 per texel at the end.
+The list is stored by normal bin, and each dispatch tests up to four nearby directions over the
+bins that can face them (core/normal_bins.py).
+Sums are float32 per entry in a fixed direction order (deterministic), float64 per texel at the end.
 """
 from __future__ import annotations
 
