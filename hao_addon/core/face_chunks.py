@@ -53,7 +53,8 @@ def face_chunks(positions: np.ndarray) -> FaceChunks:
         return FaceChunks(np.zeros(0, np.int64), np.zeros((0, 2, 3)), np.zeros((0, 2, 3)))
     # Per-corner elementwise ops: numpy reductions over an axis of length 3 are ~10x slower.
     centroid = (tri[:, 0] + tri[:, 1] + tri[:, 2]) / 3.0
-    lo, hi = centroid.min(axis=0), centroid.max(axis=0)
+    lo = np.array([centroid[:, k].min() for k in range(3)])
+    hi = np.array([centroid[:, k].max() for k in range(3)])
     cells = (1 << _MORTON_BITS) - 1
     q = np.clip((centroid - lo) / np.maximum(hi - lo, 1e-300) * cells, 0, cells).astype(np.uint64)
     code = _spread_bits(q[:, 0]) | (_spread_bits(q[:, 1]) << np.uint64(1)) | (_spread_bits(q[:, 2]) << np.uint64(2))

@@ -43,7 +43,11 @@ def face_normals_areas(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     cross = np.cross(ab, ac)
     length = np.sqrt(np.einsum("ij,ij->i", cross, cross))
     # Relative threshold: an area tiny against the triangle's own edge lengths is noise.
-    edge = np.maximum(np.maximum(np.abs(ab).max(axis=1), np.abs(ac).max(axis=1)), 1e-300)
+    # Elementwise over the columns: numpy reductions over an axis of length 3 are ~10x slower.
+    edge = np.abs(ab[:, 0])
+    for column in (ab[:, 1], ab[:, 2], ac[:, 0], ac[:, 1], ac[:, 2]):
+        np.maximum(edge, np.abs(column), out=edge)
+    np.maximum(edge, 1e-300, out=edge)
     valid = length > 1e-12 * edge * edge
     normals = np.zeros_like(cross)
     normals[valid] = cross[valid] / length[valid, None]
@@ -184,7 +188,7 @@ def component_labels(tri: np.ndarray, vertex_count: int) -> np.ndarray:
     label = np.arange(vertex_count)
     corners = tri.ravel()
     while True:
-        smallest = np.repeat(label[tri].min(axis=1), 3)
+        smallest = np.repeat(np.minimum(np.minimum(label[tri[:, 0]], label[tri[:, 1]]), label[tri[:, 2]]), 3)
         new = label.copy()
         np.minimum.at(new, label[corners], smallest)  # hook each corner's root to the minimum
         while True:
