@@ -26,26 +26,22 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
   return (depth - bias <= texelFetch(depth_tex, px, 0).r) ? 1.0 : 0.0;
 }
 
-/* Adds one view's term to sum when the entry faces that light. */
+/* Hemisphere weight of a light at cos_theta > 0 (times 1 / S_f, added in GATHER_VIEW). */
 #ifdef UNIFORM_WEIGHTING
-#  define GATHER_VIEW(depth_tex, k) \
-    { \
-      float cos_theta = dot(normal, views.omega[k].xyz); \
-      if (cos_theta > 0.0) { \
-        float weight = position.w; \
-        sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
-      } \
-    }
+#  define VIEW_WEIGHT(cos_theta) 1.0
 #else
-#  define GATHER_VIEW(depth_tex, k) \
-    { \
-      float cos_theta = dot(normal, views.omega[k].xyz); \
-      if (cos_theta > 0.0) { \
-        float weight = cos_theta * position.w; \
-        sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
-      } \
-    }
+#  define VIEW_WEIGHT(cos_theta) (cos_theta)
 #endif
+
+/* Adds one view's term to sum when the entry faces that light. */
+#define GATHER_VIEW(depth_tex, k) \
+  { \
+    float cos_theta = dot(normal, views.omega[k].xyz); \
+    if (cos_theta > 0.0) { \
+      float weight = VIEW_WEIGHT(cos_theta) * position.w; \
+      sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
+    } \
+  }
 
 void main()
 {

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import column_bounds
+
 # Faces per chunk, the unit a draw range is cut to: small, because every averted face in a
 # picked chunk is drawn (16 draws a third of the faces 128 did on the bunny). The box test
 # runs on groups of CHUNKS_PER_GROUP chunks first and on the chunks of the groups it picked,
@@ -53,8 +55,7 @@ def face_chunks(positions: np.ndarray) -> FaceChunks:
         return FaceChunks(np.zeros(0, np.int64), np.zeros((0, 2, 3)), np.zeros((0, 2, 3)))
     # Per-corner elementwise ops: numpy reductions over an axis of length 3 are ~10x slower.
     centroid = (tri[:, 0] + tri[:, 1] + tri[:, 2]) / 3.0
-    lo = np.array([centroid[:, k].min() for k in range(3)])
-    hi = np.array([centroid[:, k].max() for k in range(3)])
+    lo, hi = column_bounds(centroid)
     cells = (1 << _MORTON_BITS) - 1
     q = np.clip((centroid - lo) / np.maximum(hi - lo, 1e-300) * cells, 0, cells).astype(np.uint64)
     code = _spread_bits(q[:, 0]) | (_spread_bits(q[:, 1]) << np.uint64(1)) | (_spread_bits(q[:, 2]) << np.uint64(2))

@@ -127,7 +127,10 @@ class GatherBaker(LightViewBaker):
         self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
                           for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
-        self.views_block = None
+        # GatherViews (gpu_shaders/bake_gather_views.glsl), std140: 4 mat4, 4 vec4, 4 vec4;
+        # one buffer per bake, rewritten before each dispatch.
+        self.views_data = np.zeros(4 * 16 + 4 * 4 + 4 * 4, np.float32)
+        self.views_block = gpu.types.GPUUniformBuf(self.views_data)
         # Batches of nearby directions face nearly the same normal bins (core/normal_bins.py).
         self.direction_order = proximity_order(plan.directions)
         self._build_texel_list()
@@ -266,14 +269,14 @@ class GatherBaker(LightViewBaker):
         views, self.pending = self.pending, []
         if not views or not self.entry_count:
             return
-        # GatherViews (gpu_shaders/bake_gather_views.glsl), std140: 4 mat4, 4 vec4, 4 vec4.
-        block = np.zeros(4 * 16 + 4 * 4 + 4 * 4, np.float32)
+        block = self.views_data
+        block[:] = 0.0
         for k, view in enumerate(views):
             block[16 * k:16 * k + 16] = view.matrix.T.ravel()  # column-major for GLSL
             block[64 + 4 * k:68 + 4 * k] = (*view.omega, 0.0)
             block[80 + 4 * k:84 + 4 * k] = (view.width, view.height,
                                             view.pixel_size / (view.depth_far - view.depth_near), 0.0)
-        self.views_block = gpu.types.GPUUniformBuf(block)  # kept until the next dispatch replaces it
+        self.views_block.update(block)
         shader = gather_shader(self.plan.settings.weighting == "uniform", len(views))
         shader.bind()
         shader.uniform_block("views", self.views_block)
