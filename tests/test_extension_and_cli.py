@@ -97,6 +97,9 @@ cube.data.uv_layers.remove(cube.data.uv_layers[0])
 bpy.ops.mesh.primitive_plane_add(size=10)
 bpy.ops.wm.save_as_mainfile(filepath=r"{tmp_path / 'scene.blend'}")
 bpy.ops.export_scene.gltf(filepath=r"{tmp_path / 'scene.glb'}")
+import os, sys
+sys.stdout.flush()
+os._exit(0)  # bpy 4.2 segfaults at interpreter exit after a glTF export (exit -11)
 """
     proc = run(["-c", script])
     assert proc.returncode == 0, proc.stderr

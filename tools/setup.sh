@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
 # Set up a fresh Debian/Ubuntu machine: OpenGL over EGL (Mesa llvmpipe works without a GPU),
-# the X11 client libraries the bpy wheel links against, and .venv with pinned requirements.
-# Safe to re-run: it reuses what is already there.
+# the X11 client libraries the bpy wheel links against, and a virtual environment with the
+# pinned requirements of one Blender release (requirements/bpy-<version>.txt).
+#
+#   bash tools/setup.sh                  # default release, in .venv
+#   HAO_BPY=4.2.23 bash tools/setup.sh   # that release, in .venv-4.2.23
+#
+# Safe to re-run: it reuses what is already there, and rebuilds an environment whose Python
+# or requirements changed. Prints the environment's folder on its last line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source tools/bpy_releases.sh
 
 APT_PACKAGES="libegl1 libegl-mesa0 libgl1-mesa-dri libgl1 libx11-6 libxi6 libxxf86vm1 libxfixes3 \
 libxrender1 libxkbcommon0 libsm6 libice6 libxext6"
@@ -17,14 +24,21 @@ if [ -n "$missing" ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing
 fi
 
-PY="${PYTHON:-python3.11}"
-command -v "$PY" >/dev/null 2>&1 || PY=python3
-if [ ! -x .venv/bin/python ]; then
-  "$PY" -m venv .venv
+release="${HAO_BPY:-$HAO_DEFAULT_BPY}"
+req="$(requirements_for "$release")"
+venv="$(venv_for "$release")"
+pyver="$(python_version_for "$release")"
+py="$(find_python "$pyver")"
+
+if [ -x "$venv/bin/python" ] && ! "$venv/bin/python" -c "import sys; sys.exit(sys.version[:len('$pyver')+1] != '$pyver.')"; then
+  rm -rf "$venv"  # made with another Python: pinned wheels would not match
 fi
-if ! .venv/bin/python -c "import bpy, xatlas, pytest, matplotlib" >/dev/null 2>&1 \
-   || ! cmp -s requirements.txt .venv/.requirements.installed; then
-  .venv/bin/python -m pip install -q --upgrade pip
-  .venv/bin/python -m pip install -q -r requirements.txt
-  cp requirements.txt .venv/.requirements.installed
+if [ ! -x "$venv/bin/python" ]; then
+  "$py" -m venv "$venv"
 fi
+if ! "$venv/bin/python" -c "import bpy, xatlas, pytest, matplotlib" >/dev/null 2>&1 \
+   || ! cmp -s "$req" "$venv/.requirements.installed"; then
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$req"
+  cp "$req" "$venv/.requirements.installed"
+fi
+echo "$venv"

@@ -9,6 +9,9 @@ In the GUI the context already exists and nothing is done.
 """
 from __future__ import annotations
 
+import glob
+import os
+
 import bpy
 import gpu
 
@@ -35,6 +38,19 @@ class _HaoGPUInitEngine(bpy.types.RenderEngine):
         pass
 
 
+def _let_mesa_software_grant_gl46() -> None:
+    """Blender's headless context creation asks EGL for OpenGL 4.6 first, then 4.5, ...
+    Mesa's software rasterizer (llvmpipe, used where no GPU render node exists) offers 4.5,
+    so that first attempt fails and EGL prints ``EGL_BAD_MATCH`` on stderr (once in 4.2,
+    three times in 5.x) before 4.5 succeeds. Telling Mesa to grant 4.6 makes the first
+    attempt succeed: Blender uses no 4.6-only feature (its GLSL is 4.30, extensions are
+    queried one by one). Only Mesa reads the variable; a user's own setting is kept."""
+    if "MESA_GL_VERSION_OVERRIDE" in os.environ:
+        return
+    if os.environ.get("LIBGL_ALWAYS_SOFTWARE") or not glob.glob("/dev/dri/renderD*"):
+        os.environ["MESA_GL_VERSION_OVERRIDE"] = "4.6"
+
+
 def ensure_gpu_context() -> None:
     """Make the ``gpu`` module usable, creating a context in background mode if needed.
 
@@ -43,6 +59,7 @@ def ensure_gpu_context() -> None:
     """
     if gpu_is_ready():
         return
+    _let_mesa_software_grant_gl46()
     if hasattr(gpu, "init"):  # newer Blender versions expose this directly
         gpu.init()
         if gpu_is_ready():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from .. import compat
 from . import util
 from .shaders import cached_shader, glsl_source
 
@@ -17,7 +18,7 @@ def _composite_info() -> "gpu.types.GPUShaderCreateInfo":
     info.sampler(0, 'FLOAT_2D', "ao_tex")
     info.sampler(1, 'FLOAT_2D', "depth_tex")
     info.fragment_out(0, 'VEC4', "frag_color")
-    info.depth_write('ANY')
+    compat.declare_depth_write(info)
     info.vertex_source(glsl_source("hao_composite.vert"))
     info.fragment_source(glsl_source("hao_composite.frag"))
     return info

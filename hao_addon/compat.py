@@ -1,0 +1,27 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The one place where supported Blender releases (4.2 LTS to 5.2 LTS) differ for this add-on.
+
+Every other module calls these instead of testing versions itself. Imports of ``bpy`` and
+``gpu`` are local, so the core floor can import this module's constants without Blender.
+"""
+from __future__ import annotations
+
+
+def declare_depth_write(info) -> None:
+    """Declare that a fragment shader writes ``gl_FragDepth`` (any value).
+
+    4.3+ has ``GPUShaderCreateInfo.depth_write`` (a ``layout(depth_any)`` the Vulkan and Metal
+    backends need); 4.2 lacks it, and there GLSL 4.30 lets any fragment shader write
+    ``gl_FragDepth`` undeclared, which is what the default (any) qualifier means.
+    """
+    if hasattr(info, "depth_write"):
+        info.depth_write('ANY')
+
+
+def module_exit_may_crash() -> bool:
+    """bpy 4.2 as a Python module segfaults at interpreter exit once a class with methods was
+    registered (an operator, or a property group with a method), even after unregistering it:
+    a teardown bug fixed in 4.3. Blender itself and later releases exit cleanly. Processes
+    that register the add-on under 4.2 (the test suite) end with ``os._exit`` instead."""
+    import bpy
+    return bpy.app.version < (4, 3, 0)
