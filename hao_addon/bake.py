@@ -16,7 +16,8 @@ from typing import Callable, Generator
 import numpy as np
 
 from .core.geometry import TriangleSoup
-from .core.plan import BakeInputError, make_plan
+from .core.errors import BakeInputError
+from .core.plan import make_plan
 from .core.seams import finalize_map
 from .core.settings import BakeSettings
 

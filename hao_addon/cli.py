@@ -1,19 +1,31 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Command line: ``python -m hao_addon bake INPUT --size N --directions D --out FILE ...`` and
-``python -m hao_addon render-ao INPUT.blend --camera NAME --width W --height H --out FILE ...``.
+"""Command line: ``python -m hao_addon bake INPUT --out FILE ...`` and
+``python -m hao_addon render-ao INPUT.blend --out FILE ...``.
 
 The same entry point is registered as a Blender command (``blender -c hao bake ...``).
-Exit codes: 0 done, 2 bad arguments or input, 3 no usable GPU, 1 anything unexpected.
-Errors are one line on stderr: ``hao: error: <what>``.
+Exit codes: 0 done, 1 internal error, 2 bad arguments or input, 3 no usable GPU,
+130 / 143 interrupted by SIGINT / SIGTERM. Every failure is one line on stderr,
+``hao: error: <what>``, with nothing written; a successful ``--quiet`` run prints nothing.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
+import traceback
+from dataclasses import asdict
 from pathlib import Path
 
+from . import __version__
+from .cli_io import EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, signals_as_exceptions
+from .cli_options import add_setting_options, option_for, settings_from_args
+from .core.errors import BakeInputError
+from .core.setting_spec import SettingError
+
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
+INPUT_FORMATS = (".obj", ".glb", ".gltf", ".blend")
+DEBUG_ENV = "HAO_DEBUG"  # set to 1: an internal error also prints its traceback and Blender's log
 
 
 class CLIError(Exception):
@@ -28,76 +40,91 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .core.settings import BakeSettings
+    from .core.view_settings import RenderSize, ViewAOSettings
+
     parser = _Parser(prog="hao", description="GPU ambient occlusion for Blender scenes and meshes.")
+    parser.add_argument("--version", action="version", version=f"hao {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     b = sub.add_parser("bake", help="bake per-texel AO of a mesh into an image file")
     b.add_argument("input", help=".obj, .glb/.gltf or .blend file")
-    b.add_argument("--out", required=True, help="output .png (16-bit) or .exr (32-bit float)")
-    b.add_argument("--size", type=int, default=1024, help="map size in texels (default 1024)")
-    b.add_argument("--directions", type=int, default=256, help="light directions (default 256)")
-    b.add_argument("--max-distance", type=float, default=0.0, help="occluder reach in scene units; 0 = unlimited")
-    b.add_argument("--falloff", choices=("none", "wendland"), default="none")
-    b.add_argument("--weighting", choices=("cosine", "uniform"), default="cosine")
-    b.add_argument("--ignore-back-faces", action="store_true")
+    b.add_argument("--out", required=True, help="output .png (16-bit) or .exr (32-bit float); "
+                                                "{object} becomes the baked object's name")
+    add_setting_options(b, BakeSettings)
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
-    b.add_argument("--margin", type=int, default=16, help="texels grown past each UV island (default 16)")
-    b.add_argument("--method", choices=("auto", "scatter", "gather"), default="auto",
-                   help="auto (default): gather for unlimited distance, scatter with --max-distance")
-    b.add_argument("--view-samples", type=float, default=2.0, help="light-view pixels per texel (default 2)")
     b.add_argument("--object", default="", help="mesh to bake (default: the mesh with the most faces)")
     b.add_argument("--occluders", choices=("target", "visible"), default="visible",
-                   help="'target': self-occlusion only; 'visible': every visible mesh occludes (default)")
-    b.add_argument("--seed", type=int, default=0)
-    b.add_argument("--quiet", action="store_true")
+                   help="target: self-occlusion only; visible: every visible mesh occludes (default)")
+    _add_run_options(b)
 
     r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
-    r.add_argument("input", help=".blend file (or .obj/.glb: then --camera is required to exist in it)")
+    r.add_argument("input", help=".blend file (or .obj/.glb with a camera in it)")
     r.add_argument("--out", required=True, help="output .png (16-bit RGBA) or .exr (32-bit float RGBA)")
     r.add_argument("--camera", default="", help="camera object (default: the scene camera)")
-    r.add_argument("--width", type=int, default=800)
-    r.add_argument("--height", type=int, default=600)
-    r.add_argument("--rays", type=int, default=32, help="rays per AO-map pixel (default 32)")
-    r.add_argument("--steps", type=int, default=8, help="fixed steps per ray (default 8)")
-    r.add_argument("--spread", type=float, default=1.0, help="ray cone, 1 = hemisphere (default 1)")
-    r.add_argument("--max-distance", type=float, default=1.0, help="d_max in scene units (default 1)")
-    r.add_argument("--grid", type=int, default=256, help="voxels along the longest side, 64..512 (default 256)")
-    r.add_argument("--scale", type=int, default=2, help="AO map is 1/scale of the image per axis (default 2)")
-    r.add_argument("--filter", type=int, default=16, help="bilateral filter size in pixels (default 16)")
+    add_setting_options(r, RenderSize)
+    add_setting_options(r, ViewAOSettings)
     r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
     r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
-    r.add_argument("--method", choices=("hao", "near", "far", "near+far", "hao+far"), default="hao",
-                   help="hao: voxels (default); near: image-space near field within --max-distance (--rays samples); "
-                        "far: sphere proxies; near+far: both; hao+far: spheres for armature meshes, voxels for the rest")
     r.add_argument("--spheres", type=int, default=0,
                    help="sync K sphere proxies on every mesh with an Armature modifier first (0: use those stored)")
-    r.add_argument("--epsilon", type=float, default=0.05, help="sphere influence cut-off (default 0.05)")
-    r.add_argument("--quiet", action="store_true")
+    _add_run_options(r)
     return parser
+
+
+def _add_run_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", default=None, metavar="PATH",
+                   help="write a machine-readable report to PATH ('-': standard output)")
+    p.add_argument("--quiet", action="store_true", help="print nothing unless it fails")
+
+
+# -- input and output checks (before anything is loaded) --------------------------------------------
+
+def check_input(path: Path, allowed: tuple[str, ...]) -> Path:
+    if not path.exists():
+        raise CLIError(f"input file not found: {path}")
+    if path.is_dir():
+        raise CLIError(f"input '{path}' is a folder, not a file")
+    if path.suffix.lower() not in allowed:
+        raise CLIError(f"unsupported input '{path.suffix}': use {', '.join(allowed)}")
+    if not os.access(path, os.R_OK):
+        raise CLIError(f"cannot read '{path}': permission denied")
+    if path.stat().st_size == 0:
+        raise CLIError(f"input '{path}' is empty")
+    return path.resolve()
+
+
+def check_json_target(spec: str | None) -> None:
+    if spec in (None, "-"):
+        return
+    folder = Path(os.path.abspath(spec)).parent
+    if not folder.is_dir():
+        raise CLIError(f"cannot write the report '{spec}': folder does not exist")
+    if Path(spec).is_dir() or not os.access(folder, os.W_OK):
+        raise CLIError(f"cannot write the report '{spec}'")
 
 
 def load_scene(path: Path) -> None:
     """Replace the current Blender session with the input file's content."""
     import bpy
 
-    if not path.is_file():
-        raise CLIError(f"input file not found: {path}")
     ext = path.suffix.lower()
-    if ext == ".blend":
-        try:
-            bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
-        except RuntimeError as exc:
-            raise CLIError(f"cannot open '{path}': {str(exc).strip().splitlines()[-1]}") from None
-        return
-    bpy.ops.wm.read_factory_settings(use_empty=True)
     try:
+        if ext == ".blend":
+            bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+            return
+        bpy.ops.wm.read_factory_settings(use_empty=True)
         if ext == ".obj":
             bpy.ops.wm.obj_import(filepath=str(path))
-        elif ext in (".glb", ".gltf"):
-            bpy.ops.import_scene.gltf(filepath=str(path))
         else:
-            raise CLIError(f"unsupported input '{ext}': use .obj, .glb, .gltf or .blend")
-    except RuntimeError as exc:
-        raise CLIError(f"cannot import '{path}': {str(exc).strip().splitlines()[-1]}") from None
+            bpy.ops.import_scene.gltf(filepath=str(path))
+    except (RuntimeError, ValueError, KeyError, OSError, UnicodeError) as exc:  # the importers' own errors
+        raise CLIError(f"cannot read '{path.name}': {_last_line(exc)}") from None
+
+
+def _last_line(exc: BaseException) -> str:
+    lines = [l.strip() for l in str(exc).strip().splitlines() if l.strip()]
+    text = lines[-1] if lines else type(exc).__name__
+    return text.removeprefix("Error: ")
 
 
 def pick_target(name: str):
@@ -114,49 +141,78 @@ def pick_target(name: str):
     return max(meshes, key=lambda o: len(o.data.polygons))
 
 
-def run_bake(args) -> int:
+# -- commands ---------------------------------------------------------------------------------------
+
+def run_bake(args, report: Report, progress: Progress) -> list[str]:
+    """Bake; returns the summary lines to print."""
     import bpy
 
-    from .blender.bake_job import BakeJob, BakeRequest
+    from .blender.bake_job import BakeJob, BakeRequest, output_path_for
+    from .blender.paths import OBJECT_TOKEN
+    from .core.imageio import check_writable
     from .core.settings import BakeSettings
 
-    load_scene(Path(args.input))
+    settings = _validated(settings_from_args(args, BakeSettings), BakeSettings)
+    report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
+    source = check_input(Path(args.input), INPUT_FORMATS)
+    report.input = str(source)
+    # Refused before a long load; checked again with the object's name once it is known.
+    check_writable(args.out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 1, source=source)
+    check_json_target(args.json)
+    with report.phase("load"):
+        progress.update("loading")
+        load_scene(source)
     target = pick_target(args.object)
-    settings = BakeSettings(size=args.size, directions=args.directions, max_distance=args.max_distance,
-                            falloff=args.falloff, weighting=args.weighting,
-                            ignore_back_faces=args.ignore_back_faces, margin=args.margin,
-                            method=args.method, view_samples=args.view_samples, seed=args.seed)
-    out = Path(args.out).resolve()
     request = BakeRequest(targets=[target], settings=settings,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
-                          filepath=str(out))
+                          filepath=str(Path(os.path.abspath(args.out))), source_path=str(source))
+    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     t0 = time.perf_counter()
-    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
     try:
-        job.run()
-        job.commit()
+        with report.phase("bake"):
+            for fraction, text in job.steps():
+                progress.update(text.split(":")[0], fraction if fraction > 0 else None)
+        with report.phase("write"):
+            job.commit()
     except BaseException:
         job.cancel()
         raise
-    if not args.quiet:
-        _obj, uv_name, result = job.results[0]
+    report.timings["unwrap"] = round(job.unwrap_seconds, 4)
+    lines = []
+    for obj, uv_name, result in job.results:
         st = result.stats
-        print(f"hao: baked '{target.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "
-              f"{args.size}x{args.size}, {args.directions} directions in {time.perf_counter() - t0:.2f} s -> {out}")
-    return EXIT_OK
+        out = output_path_for(request, obj)
+        report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
+                                   uv_map_created=any(n == uv_name for _m, n in job.created_uv),
+                                   covered_texels=st["covered_texels"], method=st["method"]))
+        report.outputs.append(out)
+        report.warnings.extend(st.get("warnings", []))
+        lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "
+                     f"{settings.size}x{settings.size}, {settings.directions} directions in "
+                     f"{time.perf_counter() - t0:.2f} s -> {out}")
+    return lines
 
 
-def run_render_ao(args) -> int:
+def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     import bpy
 
-    from .core.imageio import format_for_path, write_ao_file
-    from .core.view_settings import ViewAOSettings
+    from .core.imageio import check_writable, write_ao_file
+    from .core.view_settings import RenderSize, ViewAOSettings
     from .render_ao import render_camera_ao
 
-    out = Path(args.out).resolve()
-    format_for_path(out)  # bad extension: fail before loading anything
-    load_scene(Path(args.input))
+    size = _validated(settings_from_args(args, RenderSize), RenderSize)
+    settings = _validated(settings_from_args(args, ViewAOSettings), ViewAOSettings)
+    if args.spheres < 0:
+        raise CLIError(f"--spheres must be 0 or a positive count, got {args.spheres}")
+    report.settings = {**asdict(size), **asdict(settings), "frame": args.frame, "spheres": args.spheres}
+    source = check_input(Path(args.input), INPUT_FORMATS)
+    report.input = str(source)
+    out = check_writable(args.out, size.width, size.height, 4, source=source)
+    check_json_target(args.json)
+    with report.phase("load"):
+        progress.update("loading")
+        load_scene(source)
     scene = bpy.context.scene
     if args.frame is not None:
         scene.frame_set(args.frame)
@@ -167,45 +223,120 @@ def run_render_ao(args) -> int:
             raise CLIError(f"no camera named '{args.camera}' (cameras: {', '.join(cams) or 'none'})")
     else:
         camera = scene.camera
-    settings = ViewAOSettings(rays=args.rays, steps=args.steps, spread=args.spread, max_distance=args.max_distance,
-                              grid=args.grid, scale=args.scale, filter_size=args.filter, method=args.method,
-                              epsilon=args.epsilon).validated()
     if args.spheres:
         from .blender.sphere_proxies import has_armature, make_proxies
         rigged = [o for o in scene.objects if o.type == 'MESH' and has_armature(o)]
         if not rigged:
             raise CLIError("--spheres: no mesh with an Armature modifier in the scene")
-        for obj in rigged:
-            make_proxies(obj, args.spheres)
+        with report.phase("spheres"):
+            for obj in rigged:
+                make_proxies(obj, args.spheres)
     t0 = time.perf_counter()
-    rgba = render_camera_ao(scene, camera, args.width, args.height, settings, skip_baked=args.skip_baked)
-    write_ao_file(out, rgba)
-    if not args.quiet:
-        print(f"hao: rendered AO from '{camera.name}' {args.width}x{args.height} in "
-              f"{time.perf_counter() - t0:.2f} s -> {out}")
-    return EXIT_OK
+    with report.phase("render"):
+        progress.update("rendering")
+        rgba = render_camera_ao(scene, camera, size.width, size.height, settings, skip_baked=args.skip_baked)
+    with report.phase("write"):
+        write_ao_file(out, rgba)
+    report.objects.append(dict(camera=camera.name))
+    report.outputs.append(str(out))
+    return [f"hao: rendered AO from '{camera.name}' {size.width}x{size.height} in "
+            f"{time.perf_counter() - t0:.2f} s -> {out}"]
 
+
+def _validated(settings, settings_cls):
+    """settings.validated(), naming the option in the message."""
+    try:
+        return settings.validated()
+    except SettingError as exc:
+        option = option_for(settings_cls, exc.name)
+        raise CLIError(f"{exc} ({option})" if option else str(exc)) from None
+
+
+COMMANDS = {"bake": run_bake, "render-ao": run_render_ao}
+
+
+# -- entry point ------------------------------------------------------------------------------------
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    started = time.perf_counter()
+    with ProcessOutput() as io, signals_as_exceptions():
+        report = Report(command=argv[0] if argv else "", hao=__version__)
+        args = None
+        try:
+            args = _parse(argv, io)
+            import bpy
+            report.blender = bpy.app.version_string
+            progress = Progress(io.err, enabled=io.err_is_terminal and not args.quiet)
+            try:
+                lines = COMMANDS[args.command](args, report, progress)
+            finally:
+                progress.finish()
+            if not args.quiet:
+                for warning in report.warnings:
+                    io.err.write(f"hao: warning: {warning}\n")
+                if args.json != "-":
+                    io.out.write("".join(line + "\n" for line in lines))
+            code = EXIT_OK
+        except SystemExit as exc:  # --help / --version
+            return int(exc.code or 0)
+        except BaseException as exc:  # noqa: BLE001 - every failure becomes one line and an exit code
+            code, message = _failure(exc, io)
+            report.status, report.error = ("interrupted" if code in EXIT_INTERRUPTED.values() else "error"), message
+            io.err.write(f"hao: error: {message}\n")
+        report.exit_code = code
+        report.timings["total"] = round(time.perf_counter() - started, 4)
+        if args is not None and args.json:
+            _write_report(report, args.json, io)
+        return code
+
+
+def _parse(argv: list[str], io: ProcessOutput) -> argparse.Namespace:
+    """parse_args with --help and --version written to the real stdout."""
+    saved = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = io.out, io.err
     try:
-        args = build_parser().parse_args(argv)
-        if args.command == "bake":
-            return run_bake(args)
-        if args.command == "render-ao":
-            return run_render_ao(args)
-        raise CLIError(f"unknown command {args.command}")
-    except CLIError as exc:
-        print(f"hao: error: {exc}", file=sys.stderr)
-        return exc.code
-    except Exception as exc:  # map the library's typed errors to exit codes
-        from .core.plan import BakeInputError
+        return build_parser().parse_args(argv)
+    finally:
+        sys.stdout, sys.stderr = saved
+
+
+def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
+    """(exit code, one-line message) for any exception."""
+    import signal
+
+    from .core.unwrap import UnwrapError
+    if isinstance(exc, KeyboardInterrupt):
+        return EXIT_INTERRUPTED[signal.SIGINT], "interrupted (SIGINT): nothing was written"
+    if isinstance(exc, Terminated):
+        return EXIT_INTERRUPTED[signal.SIGTERM], "terminated (SIGTERM): nothing was written"
+    if isinstance(exc, CLIError):
+        return exc.code, str(exc)
+    try:
         from .gpu.context import GPUUnavailableError
-        if isinstance(exc, GPUUnavailableError):
-            print(f"hao: error: {exc}", file=sys.stderr)
-            return EXIT_NO_GPU
-        if isinstance(exc, (BakeInputError, ValueError, OSError, KeyError)):
-            msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-            print(f"hao: error: {msg}", file=sys.stderr)
-            return EXIT_BAD_INPUT
-        raise
+    except ImportError:  # no bpy at all
+        GPUUnavailableError = ()  # noqa: N806
+    if GPUUnavailableError and isinstance(exc, GPUUnavailableError):
+        return EXIT_NO_GPU, _last_line(exc)
+    if isinstance(exc, (BakeInputError, UnwrapError, OSError)):
+        return EXIT_BAD_INPUT, _last_line(exc)
+    if os.environ.get(DEBUG_ENV):
+        io.err.write(io.log() + "".join(traceback.format_exception(exc)))
+    return EXIT_FAILURE, (f"internal error ({type(exc).__name__}: {_last_line(exc)}); "
+                          f"run with {DEBUG_ENV}=1 for details")
+
+
+def _write_report(report: Report, target: str, io: ProcessOutput) -> None:
+    text = report.to_json()
+    if target == "-":
+        io.out.write(text)
+        return
+    try:
+        check_json_target(target)
+    except CLIError:
+        return  # that was the error already reported
+    from .core.imageio import atomic_write_bytes
+    try:
+        atomic_write_bytes(Path(os.path.abspath(target)), text.encode())
+    except OSError as exc:
+        io.err.write(f"hao: error: cannot write the report '{target}': {exc.strerror or exc}\n")

@@ -25,3 +25,13 @@ def module_exit_may_crash() -> bool:
     that register the add-on under 4.2 (the test suite) end with ``os._exit`` instead."""
     import bpy
     return bpy.app.version < (4, 3, 0)
+
+
+def path_property_options() -> set[str]:
+    """Options of a FILE_PATH StringProperty that accepts '//' (blend-relative) paths: 4.5+
+    warns on such paths unless the property declares PATH_SUPPORTS_BLEND_RELATIVE, which
+    4.2 does not know (registering it there fails)."""
+    import bpy
+    if "is_path_supports_blend_relative" in bpy.types.Property.bl_rna.properties:
+        return {'PATH_SUPPORTS_BLEND_RELATIVE'}
+    return set()

@@ -8,8 +8,8 @@ import numpy as np
 
 from .blender.sphere_proxies import scene_spheres
 from .blender.view_scene import camera_view_projection, visible_scene_objects
-from .core.plan import BakeInputError
-from .core.view_settings import ViewAOSettings
+from .core.errors import BakeInputError
+from .core.view_settings import RenderSize, ViewAOSettings, render_gpu_bytes
 
 
 def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: int, height: int,
@@ -20,12 +20,14 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     (its skips then apply across calls); by default a temporary one."""
     from .gpu.context import ensure_gpu_context
     from .gpu.hao_renderer import HaoRenderer
-    from .gpu.util import texture_to_numpy
+    from .gpu.util import check_render_limits, texture_to_numpy
 
     if camera is None or camera.type != 'CAMERA':
         raise BakeInputError("no camera: pass --camera NAME or give the scene a camera")
     settings = settings.validated()
+    RenderSize(width, height).validated()
     ensure_gpu_context()
+    check_render_limits(width, height, render_gpu_bytes(width, height, settings))
     depsgraph = bpy.context.evaluated_depsgraph_get()
     view_layer = bpy.context.view_layer
     objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)

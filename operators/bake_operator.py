@@ -8,7 +8,7 @@ import time
 import bpy
 
 from ..hao_addon.blender.bake_job import BakeJob
-from ..hao_addon.core.plan import BakeInputError
+from ..hao_addon.core.errors import BakeInputError
 from ..hao_addon.gpu.context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
 
@@ -91,8 +91,11 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         request = context.scene.hao_bake.to_request(bake_targets(context))
         return BakeJob(request, context.evaluated_depsgraph_get)
 
-    def _report_images(self, images) -> None:
-        names = ", ".join(f"'{im.name}'" for im in images)
+    def _report_done(self, job: BakeJob) -> None:
+        for _obj, _uv, result in job.results:
+            for warning in result.stats.get("warnings", []):
+                self.report({'WARNING'}, warning)
+        names = ", ".join(f"'{im.name}'" for im in job.committed)
         self.report({'INFO'}, f"Baked AO into {names}")
 
     def execute(self, context):
@@ -103,7 +106,7 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
             return {'CANCELLED'}
         try:
             job.run()
-            images = job.commit()
+            job.commit()
         except USER_ERRORS as exc:
             job.cancel()
             self.report({'ERROR'}, f"Bake AO failed: {exc}")
@@ -111,7 +114,7 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         except BaseException:
             job.cancel()
             raise
-        self._report_images(images)
+        self._report_done(job)
         return {'FINISHED'}
 
     def invoke(self, context, event):
@@ -142,9 +145,9 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
             self.report({'ERROR'}, f"Bake AO failed: {exc}")
             return {'CANCELLED'}
         if done:
-            images = self._runner.job.committed
+            job = self._runner.job
             self._stop(context, cancelled=False)
-            self._report_images(images)
+            self._report_done(job)
             return {'FINISHED'}
         return {'RUNNING_MODAL'}
 

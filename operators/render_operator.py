@@ -6,6 +6,8 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
+from ..hao_addon import compat
+
 IMAGE_NAME = "HAO Render"
 
 
@@ -17,7 +19,7 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
     bl_options = {'REGISTER'}
 
     filepath: StringProperty(name="File", description="Also save to this .png (16-bit) or .exr (32-bit) file",
-                             default="", subtype='FILE_PATH')
+                             default="", subtype='FILE_PATH', options=compat.path_property_options())
 
     @classmethod
     def poll(cls, context):
@@ -27,9 +29,10 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
         return True
 
     def execute(self, context):
+        from ..hao_addon.blender.paths import absolute_path
         from ..hao_addon.blender.view_scene import region_box
-        from ..hao_addon.core.imageio import write_ao_file
-        from ..hao_addon.core.plan import BakeInputError
+        from ..hao_addon.core.errors import BakeInputError
+        from ..hao_addon.core.imageio import check_writable, write_ao_file
         from ..hao_addon.gpu.context import GPUUnavailableError
         from ..hao_addon.render_ao import render_camera_ao
 
@@ -39,11 +42,13 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
         width = max(1, int(r.resolution_x * r.resolution_percentage / 100))
         height = max(1, int(r.resolution_y * r.resolution_percentage / 100))
         try:
+            # The file is checked before rendering, so a bad path costs no GPU time.
+            path = check_writable(absolute_path(self.filepath), width, height, 4) if self.filepath else None
             rgba = render_camera_ao(scene, scene.camera, width, height, props.to_settings(),
                                     region=region_box(props), skip_baked=props.skip_baked)
-            if self.filepath:
-                write_ao_file(bpy.path.abspath(self.filepath), rgba)
-        except (BakeInputError, GPUUnavailableError, OSError, ValueError) as exc:
+            if path is not None:
+                write_ao_file(path, rgba)
+        except (BakeInputError, GPUUnavailableError, OSError) as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
         image = bpy.data.images.get(IMAGE_NAME)

@@ -167,7 +167,8 @@ def test_cancel_leaves_no_image_uv_map_or_material_change(scene, addon):
 
     wm, ws = FakeWM(), FakeWorkspace()
     runner = ModalBakeRunner(job, wm, ws)
-    assert runner.tick(budget_s=0.05) is False  # part-way through
+    while runner.fraction == 0.0:  # the xatlas unwrap first (a child process), then directions
+        assert runner.tick(budget_s=0.05) is False
     assert 0 < runner.fraction < 1 and "Esc to cancel" in ws.texts[-1]
     assert "AO_UV" in obj.data.uv_layers  # the only early change...
     runner.cancel()
@@ -235,3 +236,43 @@ def test_selected_occluders_darken_the_floor(scene):
     shaded = image_pixels_gray(bpy.data.images["Floor_AO"])
     assert shaded[64, 64] < 0.2 and shaded[2, 2] > 0.95  # contact point dark, corners open
     assert "Ball_AO" in bpy.data.images
+
+
+def unwrap_children() -> list[int]:
+    import os
+    from pathlib import Path
+    pid = os.getpid()
+    kids = [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+    return [k for k in kids if "unwrap_worker" in Path(f"/proc/{k}/cmdline").read_text(errors="replace")]
+
+
+def test_esc_during_the_unwrap_stops_xatlas_and_changes_nothing(scene):
+    from hao_ext.operators.bake_operator import ModalBakeRunner
+    from hao_addon.blender.bake_job import BakeJob
+    import time
+
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=192, ring_count=96)  # ~36k triangles: seconds of xatlas
+    obj = bpy.context.active_object
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    images_before = set(bpy.data.images.keys())
+    job = BakeJob(small_settings(scene, uv_mode='AUTO').to_request([obj]), bpy.context.evaluated_depsgraph_get)
+    runner = ModalBakeRunner(job)
+    assert runner.tick(budget_s=0.3) is False
+    assert runner.fraction == 0.0 and runner.status.startswith("Unwrapping 'Sphere'")
+    assert unwrap_children()  # xatlas runs in a child process, so the UI keeps ticking
+    t0 = time.monotonic()
+    runner.cancel()
+    assert time.monotonic() - t0 < 1.0 and unwrap_children() == []
+    assert [l.name for l in obj.data.uv_layers] == [] and set(bpy.data.images.keys()) == images_before
+    assert live_pass_count() == 0
+
+
+def test_uv_layout_problems_are_reported_as_warnings(scene, capfd):
+    obj = monkey()
+    uv = uv_array(obj.data, "UVMap").reshape(-1, 2)
+    obj.data.uv_layers["UVMap"].uv.foreach_set("vector", (uv * 0.5 + [0.7, 0.0]).ravel())  # past u = 1
+    small_settings(scene)
+    capfd.readouterr()
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    out = capfd.readouterr().out
+    assert "Warning: 'Suzanne':" in out and "outside the 0..1 UV tile" in out, out

@@ -9,7 +9,7 @@ from bake_helpers import assert_within_sample_tolerance, error_stats, texel_poin
 from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.plan import BakeInputError
+from hao_addon.core.errors import BakeInputError
 from hao_addon.core.settings import BakeSettings
 
 SIZE, DIRS = 128, 128
@@ -28,7 +28,11 @@ VARIANTS = [("scatter", 0.0), ("scatter", 1.5), ("gather", 0.0)]
 
 
 def settings(method, max_distance=0.0, **kw):
-    return BakeSettings(size=SIZE, directions=DIRS, margin=0, method=method, max_distance=max_distance, **kw)
+    # Each comparison bakes one surface twice with differently fitted light views (another
+    # scale, offset or extra degenerate geometry moves the pixel grid); at 4 light-view pixels
+    # per texel that sampling difference stays below the bound of assert_same_map.
+    return BakeSettings(size=SIZE, directions=DIRS, margin=0, method=method, max_distance=max_distance,
+                        **{"view_samples": 4.0, **kw})
 
 
 @pytest.fixture(scope="module")

@@ -8,18 +8,19 @@ for meshes without UVs (the evaluated mesh must carry it); ``cancel`` removes it
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Generator
 
 import bpy
 
 from ..bake import BakeResult, bake_steps
-from ..core.imageio import format_for_path, write_ao_file
-from ..core.plan import BakeInputError
+from ..core.imageio import check_writable, write_ao_file
+from ..core.errors import BakeInputError
 from ..core.settings import BakeSettings
-from ..core.unwrap import xatlas_unwrap
+from ..core.unwrap import unwrap_steps
 from . import images, mesh_data
+from .paths import OBJECT_TOKEN, absolute_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
@@ -32,7 +33,8 @@ class BakeRequest:
     active render UV map, or 'AUTO': AO_UV if present, else the first UV map, else a new
     AO_UV unwrapped with xatlas.
     image: an existing image to overwrite (one target only), else '<object>_AO' is created.
-    filepath: '' or a .png/.exr path; with several targets '{object}' in it is replaced."""
+    filepath: '' or a .png/.exr path; '{object}' in it becomes each object's name (with several
+    targets and no token, '_{object}' is appended)."""
 
     targets: list
     settings: BakeSettings
@@ -42,18 +44,19 @@ class BakeRequest:
     image_name: str = ""
     filepath: str = ""
     wire_material: bool = False
+    source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
 
 
 def output_path_for(request: BakeRequest, obj) -> str:
+    """The file an object's map is saved to: '{object}' becomes its name; with several targets
+    and no token, '_{object}' is added before the extension."""
     if not request.filepath:
         return ""
-    path = bpy.path.abspath(request.filepath)
-    if len(request.targets) > 1:
-        if "{object}" not in path:
-            stem, ext = os.path.splitext(path)
-            path = f"{stem}_{{object}}{ext}"
-        path = path.replace("{object}", bpy.path.clean_name(obj.name))
-    return path
+    path = absolute_path(request.filepath)
+    if len(request.targets) > 1 and OBJECT_TOKEN not in path:
+        stem, ext = os.path.splitext(path)
+        path = f"{stem}_{OBJECT_TOKEN}{ext}"
+    return path.replace(OBJECT_TOKEN, object_file_name(obj))
 
 
 def validate_request(request: BakeRequest) -> None:
@@ -75,18 +78,29 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
     if request.image is not None and len(request.targets) > 1:
         raise BakeInputError("an existing image can receive only one object's bake")
+    writers: dict[str, str] = {}
     for obj in request.targets:
         path = output_path_for(request, obj)
-        if path:
-            try:
-                format_for_path(path)
-            except ValueError as exc:
-                raise BakeInputError(str(exc)) from None
-            folder = Path(path).parent
-            if not folder.is_dir():
-                raise BakeInputError(f"cannot write '{path}': folder does not exist")
-            if not os.access(folder, os.W_OK) or (Path(path).exists() and not os.access(path, os.W_OK)):
-                raise BakeInputError(f"cannot write '{path}': permission denied")
+        if not path:
+            continue
+        if path in writers:
+            raise BakeInputError(f"'{writers[path]}' and '{obj.name}' would both be saved as '{path}': "
+                                 f"rename one of them")
+        writers[path] = obj.name
+        size = request.settings.size
+        check_writable(path, size, size, 1, source=request.source_path or None)
+
+
+def _with_status(steps: Generator, fraction: float, text: str) -> Generator[tuple[float, str], None, object]:
+    """Re-yield a generator's steps as (fraction, text); return its value; close it on exit."""
+    try:
+        while True:
+            next(steps)
+            yield fraction, text
+    except StopIteration as stop:
+        return stop.value
+    finally:
+        steps.close()
 
 
 class BakeJob:
@@ -100,9 +114,11 @@ class BakeJob:
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.committed: list[bpy.types.Image] = []
         self.finished = False
+        self.unwrap_seconds = 0.0
 
     # -- preparation -----------------------------------------------------------------------
-    def _uv_name_for(self, obj) -> str:
+    def _uv_name_for(self, obj) -> Generator[tuple[float, str], None, str]:
+        """The UV map to bake into (yields while xatlas unwraps a mesh that has none)."""
         mesh = obj.data
         name = self.request.uv_map
         if name == "":
@@ -115,7 +131,10 @@ class BakeJob:
         if mesh.uv_layers:
             return mesh.uv_layers[0].name  # AUTO: the first UV map when there is one
         positions, tris, tri_loops = mesh_data.base_mesh_triangles(obj)
-        uvs = xatlas_unwrap(positions, tris, self.request.settings.size)
+        unwrap = unwrap_steps(positions, tris, self.request.settings.size, name=obj.name)
+        t0 = time.perf_counter()
+        uvs = yield from _with_status(unwrap, 0.0, f"Unwrapping '{obj.name}' (xatlas)")
+        self.unwrap_seconds += time.perf_counter() - t0
         new_name = mesh_data.add_uv_layer(mesh, mesh_data.AO_UV_NAME, tri_loops, uvs)
         self.created_uv.append((mesh, new_name))
         return new_name
@@ -140,7 +159,9 @@ class BakeJob:
     def steps(self) -> Generator[tuple[float, str], None, None]:
         """Yield (fraction done, status text) after each light direction."""
         req = self.request
-        uv_names = {obj.name: self._uv_name_for(obj) for obj in req.targets}
+        uv_names = {}
+        for obj in req.targets:
+            uv_names[obj.name] = yield from self._uv_name_for(obj)
         depsgraph = self._depsgraph_getter()
         n = len(req.targets)
         for k, obj in enumerate(req.targets):

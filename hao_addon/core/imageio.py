@@ -10,6 +10,7 @@ files get the standard top-row-first orientation.
 from __future__ import annotations
 
 import os
+import shutil
 import struct
 import tempfile
 import zlib
@@ -17,21 +18,77 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import BakeInputError
+
 FORMATS = {".png": "PNG", ".exr": "OPEN_EXR"}
+TEMP_PREFIX = ".hao-"
 
 
 def format_for_path(path: str | Path) -> str:
     ext = Path(path).suffix.lower()
     if ext not in FORMATS:
-        raise ValueError(f"unsupported output extension '{ext}': use .png (16-bit) or .exr (32-bit float)")
+        raise BakeInputError(f"unsupported output extension '{ext}': use .png (16-bit) or .exr (32-bit float)")
     return FORMATS[ext]
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
+def file_bytes_estimate(path: str | Path, width: int, height: int, channels: int) -> int:
+    """Upper bound of the file's size: EXR is uncompressed float32, PNG is 16-bit whose deflate
+    stream is at most slightly larger than the raw rows."""
+    per_sample = 4 if format_for_path(path) == "OPEN_EXR" else 2
+    raw = width * height * channels * per_sample + height * (8 + 1)
+    return raw + raw // 1000 + 4096
+
+
+def check_writable(path: str | Path, width: int, height: int, channels: int, source: str | Path | None = None) -> Path:
+    """Refuse, before any work, an output that could not be written: unsupported extension, the
+    input file itself, a missing or read-only folder, a name too long for the file system,
+    an existing folder or read-only file of that name, or too little free space. Returns the
+    absolute path. (The write itself is atomic: a temporary file renamed into place.)"""
+    path = Path(os.path.abspath(path))
+    format_for_path(path)
+    if source is not None and path == Path(os.path.abspath(source)):
+        raise BakeInputError(f"the output '{path}' is the input file: choose another name")
+    folder = path.parent
+    if not folder.is_dir():
+        raise BakeInputError(f"cannot write '{path}': folder does not exist")
+    try:
+        name_max = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):  # no pathconf (Windows): NTFS allows 255
+        name_max = 255
+    if len(os.fsencode(path.name)) > name_max:
+        raise BakeInputError(f"cannot write '{path.name}': the name is longer than the file system's "
+                             f"{name_max}-byte limit")
+    if path.is_dir():
+        raise BakeInputError(f"cannot write '{path}': it is a folder")
+    if not _can_create_in(folder) or (path.exists() and not os.access(path, os.W_OK)):
+        raise BakeInputError(f"cannot write '{path}': permission denied")
+    needed = file_bytes_estimate(path, width, height, channels)
+    free = shutil.disk_usage(folder).free
+    if needed > free:
+        raise BakeInputError(f"cannot write '{path}': it needs up to {needed / 2**20:.1f} MiB, "
+                             f"the disk has {free / 2**20:.1f} MiB free")
+    return path
+
+
+def _can_create_in(folder: Path) -> bool:
+    """Whether a file can be created there: tried, since os.access answers yes for root even
+    where the file system refuses (sysfs, read-only mounts, some network shares)."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".probe", dir=folder)
+    except OSError:
+        return False
+    os.close(fd)
+    os.unlink(probe)
+    return True
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write data to path through a temporary file in the same folder, renamed into place."""
     path = Path(path)
     if not path.parent.is_dir():
         raise OSError(f"output folder does not exist: {path.parent}")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    # A short temporary name: the target's own name can already be at the length limit.
+    fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -111,4 +168,4 @@ def write_ao_file(path: str | Path, image: np.ndarray) -> None:
     fmt = format_for_path(path)
     if not np.isfinite(image).all():
         raise ValueError("refusing to write an AO map containing NaN or Inf")
-    _atomic_write(Path(path), png16_bytes(image) if fmt == "PNG" else exr32_bytes(image))
+    atomic_write_bytes(Path(path), png16_bytes(image) if fmt == "PNG" else exr32_bytes(image))

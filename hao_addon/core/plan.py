@@ -12,10 +12,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .directions import bake_directions
+from .errors import BakeInputError
 from .geometry import (TriangleSoup, bounding_sphere, column_bounds, face_normals_areas, surface_holes,
                        uv_areas, weld)
 from .normalization import face_normalizers
 from .settings import BakeSettings
+from .uv_checks import uv_layout_warnings
 from .views import OrthoView, fit_views
 
 # The light view never exceeds this many pixels per side (GPU limit is checked separately);
@@ -30,10 +32,6 @@ DENSITY_PERCENTILE = 0.10
 # that, the bake uses the footprint-splitting shader variant (slower, so only then).
 FOOTPRINT_SPLIT = 1.5
 DENSE_AREA_LIMIT = 0.005
-
-
-class BakeInputError(ValueError):
-    """The input cannot be baked; the message says why in words a user can act on."""
 
 
 @dataclass
@@ -129,6 +127,7 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     uv_area = uv_areas(target.uvs)
     if not (uv_area > 0.0).any():
         raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
+    uv_warnings, uv_counters = uv_layout_warnings(target.uvs, settings.size, target.name)
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
@@ -198,7 +197,7 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
                  occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
                  dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
-                 holes=-1 if holes is None else len(holes))
+                 holes=-1 if holes is None else len(holes), warnings=uv_warnings, **uv_counters)
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32),
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,

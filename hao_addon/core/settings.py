@@ -1,61 +1,72 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Bake settings shared by the operator, the CLI and the tests (plain data, validated)."""
+"""Bake settings shared by the operator, the CLI and the tests (plain data, validated).
+
+Each field is the one definition of its setting (default, range, unit, description): the
+Blender properties, the command-line options and the README table are made from it.
+"""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from .kernels import FALLOFFS
-from .normalization import WEIGHTINGS
+from .errors import BakeInputError
+from .setting_spec import Choice, setting, validate
 
-METHODS = ("auto", "scatter", "gather")
 MAX_DIRECTIONS = 65536
+MAX_MAP_SIZE = 16384
+
+FALLOFF_CHOICES = (
+    Choice("none", "None", "full occlusion up to the max distance, none beyond"),
+    Choice("wendland", "Smooth (Wendland)", "fades smoothly to zero at the max distance (Hybrid AO paper, eq. 3)"),
+)
+WEIGHTING_CHOICES = (
+    Choice("cosine", "Cosine", "Lambertian ambient occlusion (what Cycles bakes)"),
+    Choice("uniform", "Uniform", "fraction of the open hemisphere"),
+)
+METHOD_CHOICES = (
+    Choice("auto", "Auto", "the gather for unlimited distance (fastest at equal error in the benchmark), "
+                           "the scatter with a max distance"),
+    Choice("scatter", "Histogram Scatter", "McGraw & Sowers: texel-area average; supports max distance and falloff"),
+    Choice("gather", "Shadow-Map Gather", "shadow maps sampled at texel centres (the paper's baseline); "
+                                          "unlimited distance only"),
+)
+METHODS = tuple(c.value for c in METHOD_CHOICES)
 
 
 @dataclass(frozen=True)
 class BakeSettings:
-    """What a bake computes.
+    """What a bake computes (see each field's description)."""
 
-    size: the AO map is size x size texels. directions: number D of light directions.
-    max_distance: occluders farther than this (world units) do not occlude; 0 = unlimited.
-    falloff: 'none' or 'wendland' (used only with a max distance). weighting: 'cosine'
-    (Lambertian AO) or 'uniform' (fraction of the hemisphere). ignore_back_faces: faces seen
-    from behind do not occlude. margin: texels grown past every UV island. method: 'scatter'
-    (McGraw & Sowers) or 'gather' (the shadow-map baseline). view_samples: light-view pixels
-    per texel (the scatter's sampling density). seed: direction-set rotation.
-    """
-
-    size: int = 1024
-    directions: int = 256
-    max_distance: float = 0.0
-    falloff: str = "none"
-    weighting: str = "cosine"
-    ignore_back_faces: bool = False
-    margin: int = 16
-    method: str = "auto"
-    view_samples: float = 4.0
-    seed: int = 0
+    size: int = setting(
+        1024, label="Size", noun="map size", minimum=16, maximum=MAX_MAP_SIZE, soft_max=8192, unit="texels",
+        subtype='PIXEL', description="width and height of the AO map (also limited by the GPU's texture size)")
+    directions: int = setting(
+        256, label="Directions", minimum=1, maximum=MAX_DIRECTIONS, soft_max=4096,
+        description="light directions; noise falls as 1/sqrt(directions), time grows linearly")
+    max_distance: float = setting(
+        0.0, label="Max Distance", minimum=0.0, soft_max=100.0, unit="scene units",
+        subtype='DISTANCE', description="occluders farther than this do not darken; 0 = unlimited")
+    falloff: str = setting(
+        "none", label="Falloff", choices=FALLOFF_CHOICES,
+        description="how occlusion fades with distance (only with a max distance)")
+    weighting: str = setting(
+        "cosine", label="Weighting", choices=WEIGHTING_CHOICES, description="how directions over the hemisphere count")
+    ignore_back_faces: bool = setting(
+        False, label="Ignore Back Faces", description="faces seen from behind do not occlude (open or single-sided meshes)")
+    margin: int = setting(
+        16, label="Margin", minimum=0, maximum=1024, unit="texels", subtype='PIXEL',
+        description="texels grown past every UV island, so filtering never reads the background")
+    method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
+    view_samples: float = setting(
+        2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
+        description="light-view pixels per texel (the scatter's sampling density): more is smoother and slower")
+    seed: int = setting(0, label="Seed", minimum=0, maximum=2**31 - 1, description="rotation of the direction set")
 
     def validated(self) -> "BakeSettings":
-        """Return self, or raise ValueError with a message a user can act on."""
-        if not 1 <= self.size <= 16384:
-            raise ValueError(f"map size must be between 1 and 16384 texels, got {self.size}")
-        if not 1 <= self.directions <= MAX_DIRECTIONS:
-            raise ValueError(f"directions must be between 1 and {MAX_DIRECTIONS}, got {self.directions}")
-        if not self.max_distance >= 0.0 or self.max_distance == float("inf"):
-            raise ValueError(f"max distance must be a finite number >= 0 (0 = unlimited), got {self.max_distance}")
-        if self.falloff not in FALLOFFS:
-            raise ValueError(f"falloff must be one of {FALLOFFS}, got '{self.falloff}'")
-        if self.weighting not in WEIGHTINGS:
-            raise ValueError(f"weighting must be one of {WEIGHTINGS}, got '{self.weighting}'")
-        if self.method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got '{self.method}'")
-        if not 0 <= self.margin <= 1024:
-            raise ValueError(f"margin must be between 0 and 1024 texels, got {self.margin}")
-        if not 0.25 <= self.view_samples <= 64.0:
-            raise ValueError(f"view samples per texel must be in [0.25, 64], got {self.view_samples}")
+        """Return self, or raise SettingError / BakeInputError with a message a user can act on."""
+        validate(self)
         if self.method == "gather" and self.max_distance > 0.0:
-            raise ValueError("the gather (shadow-map) baseline supports only unlimited distance: "
-                             "a depth map keeps the occluder nearest the light, not the one nearest the texel")
+            raise BakeInputError("the gather (shadow-map) baseline supports only unlimited distance: "
+                                 "a depth map keeps the occluder nearest the light, not the one nearest the texel")
         return self
 
     @property

@@ -1,32 +1,135 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Automatic UV atlas with xatlas for meshes that have no UV map (CPU; no bpy)."""
+"""Automatic UV atlas with xatlas for meshes that have no UV map (CPU; no bpy).
+
+Two things make xatlas safe to call on any mesh here:
+- scale: xatlas' epsilons are absolute, so a mesh of 1e10 units ran for minutes and one of
+  1e-4 units packed nothing. It unwraps a copy centred and scaled to unit size; UVs do not
+  depend on scale, so the real positions are never needed.
+- interrupts: xatlas holds the interpreter lock until it returns, so it runs in a child
+  process (``unwrap_worker.py``) that is killed at once on Ctrl-C, SIGTERM or Esc.
+"""
 from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Generator
 
 import numpy as np
 
+from .errors import BakeInputError
+from .unwrap_worker import atlas_uvs
 
-def xatlas_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int, padding: int = 4) -> np.ndarray:
-    """Per-corner UVs in [0, 1] for a triangle mesh.
+# Texels kept free around each chart (>= 2 so the bake's one-texel tent and bilinear lookups
+# never mix charts).
+DEFAULT_PADDING = 4
+# A triangle whose area is below this fraction of the (unit) bounding box is treated as
+# degenerate when deciding whether anything can be unwrapped at all.
+MIN_RELATIVE_AREA = 1e-14
+POLL_SECONDS = 0.02
+WORKER = Path(__file__).with_name("unwrap_worker.py")
 
-    vertices: (V, 3) float; triangles: (F, 3) int vertex indices. resolution: the texture
-    size the atlas is packed for; padding: texels kept free around each chart (>= 2 so the
-    bake's one-texel tent and bilinear lookups never mix charts).
-    Returns (F, 3, 2) float64, corner k of triangle f at [f, k].
-    """
-    import xatlas  # shipped as a wheel with the extension
 
-    atlas = xatlas.Atlas()
-    atlas.add_mesh(np.ascontiguousarray(vertices, dtype=np.float32),
-                   np.ascontiguousarray(triangles, dtype=np.uint32))
-    chart_options = xatlas.ChartOptions()
-    pack_options = xatlas.PackOptions()
-    pack_options.resolution = int(resolution)
-    pack_options.padding = int(padding)
-    pack_options.bilinear = True
-    atlas.generate(chart_options, pack_options)
-    vmapping, indices, uvs = atlas[0]
-    if len(indices) != len(triangles):
-        raise RuntimeError(f"xatlas returned {len(indices)} triangles for {len(triangles)}")
-    if atlas.atlas_count != 1:
-        raise RuntimeError(f"xatlas packed {atlas.atlas_count} atlases; only one UV tile is supported")
-    return np.asarray(uvs, dtype=np.float64)[np.asarray(indices)]
+class UnwrapError(BakeInputError):
+    """The mesh cannot be unwrapped; the message says why."""
+
+
+def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -> np.ndarray:
+    """(V, 3) float32: the vertices centred on their box and scaled so its longest side is 1.
+
+    Raises UnwrapError for meshes xatlas cannot unwrap: no triangles, non-finite or
+    out-of-range indices, or no triangle with area."""
+    v = np.asarray(vertices, np.float64)
+    t = np.asarray(triangles)
+    if len(t) == 0 or len(v) == 0:
+        raise UnwrapError(f"'{name}' has no triangles to unwrap")
+    if t.min() < 0 or t.max() >= len(v):
+        raise UnwrapError(f"'{name}' has triangle indices outside its {len(v)} vertices")
+    used = v[np.unique(t)]
+    if not np.isfinite(used).all():
+        raise UnwrapError(f"'{name}' has NaN or infinite vertex positions: cannot unwrap it")
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    extent = float((hi - lo).max())
+    if not extent > 0.0:
+        raise UnwrapError(f"'{name}' has only zero-area triangles: nothing to unwrap")
+    unit = (v - (lo + hi) * 0.5) / extent
+    p = unit[t]
+    area2 = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    if not (area2 > 2.0 * MIN_RELATIVE_AREA).any():
+        raise UnwrapError(f"'{name}' has only zero-area triangles: nothing to unwrap")
+    return unit.astype(np.float32)
+
+
+def xatlas_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
+                  padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
+    """Per-corner UVs (F, 3, 2) float64 in [0, 1], in this process (blocks until done).
+
+    vertices: (V, 3) float, any scale and offset; triangles: (F, 3) int vertex indices;
+    resolution: the texture size the atlas is packed for."""
+    unit = unit_copy(vertices, triangles, name)
+    try:
+        return atlas_uvs(unit, np.asarray(triangles, np.uint32), resolution, padding)
+    except RuntimeError as exc:
+        raise UnwrapError(f"cannot unwrap '{name}': {exc}") from None
+
+
+def worker_python() -> str | None:
+    """The interpreter for the child, or None where this process has none to start (an
+    embedding without a Python executable): then the unwrap runs in-process."""
+    exe = sys.executable
+    if exe and Path(exe).is_file() and Path(exe).name.lower().startswith("python"):
+        return exe
+    return None
+
+
+def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
+                 padding: int = DEFAULT_PADDING, name: str = "mesh") -> Generator[None, None, np.ndarray]:
+    """Like xatlas_unwrap, in a child process: yields while it runs (poll, report progress,
+    or close the generator to kill it), returns the UVs (F, 3, 2).
+
+    Closing the generator, or an exception in the caller while it is suspended (Ctrl-C),
+    kills the child and removes its temporary folder at once."""
+    unit = unit_copy(vertices, triangles, name)
+    python = worker_python()
+    if python is None:
+        yield
+        return xatlas_unwrap(unit, triangles, resolution, padding, name)
+    folder = tempfile.mkdtemp(prefix="hao-unwrap-")
+    proc = None
+    try:
+        source, target = os.path.join(folder, "in.npz"), os.path.join(folder, "out.npy")
+        np.savez(source, vertices=unit, triangles=np.asarray(triangles, np.uint32),
+                 resolution=np.int64(resolution), padding=np.int64(padding))
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+        with open(os.path.join(folder, "err.txt"), "wb") as err:
+            proc = subprocess.Popen([python, str(WORKER), source, target], stdin=subprocess.DEVNULL,
+                                    stdout=subprocess.DEVNULL, stderr=err, env=env)
+        while proc.poll() is None:
+            yield
+            time.sleep(POLL_SECONDS)
+        if proc.returncode != 0:
+            message = Path(folder, "err.txt").read_text(errors="replace").strip().splitlines()
+            raise UnwrapError(f"cannot unwrap '{name}': {message[-1] if message else f'exit {proc.returncode}'}")
+        return np.load(target)
+    finally:
+        if proc is not None and proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def run_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
+               padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
+    """Blocking unwrap in a child process (interruptible); returns (F, 3, 2) UVs."""
+    steps = unwrap_steps(vertices, triangles, resolution, padding, name)
+    try:
+        while True:
+            next(steps)
+    except StopIteration as stop:
+        return stop.value
+    finally:
+        steps.close()

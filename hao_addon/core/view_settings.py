@@ -2,52 +2,89 @@
 """Settings of the viewport / render-time Hybrid Ambient Occlusion (pure Python).
 
 Defaults follow the HAO paper's Table 1 (32 rays, 8 steps, 256^3 grid, AO map at half the
-screen resolution per axis, bilateral filter of 16 pixels)."""
+screen resolution per axis, bilateral filter of 16 pixels). Each field is the one definition
+of its setting; the panel's properties, render-ao's options and the README table come from it.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .plan import BakeInputError
+from .setting_spec import Choice, setting, validate
 
 GRID_MIN, GRID_MAX = 64, 512
-# 'hao': voxel AO (everything); 'far': sphere proxies only; 'hao+far': voxels for the objects
-# without proxies and spheres for those with them (each occluder counted once); 'near':
-# image-space near field within max_distance (rays = samples per pixel); 'near+far': both.
-METHODS = ("hao", "far", "hao+far", "near", "near+far")
+MAX_RENDER_SIDE = 65536
+
+METHOD_CHOICES = (
+    Choice("hao", "HAO Voxels", "voxel ray-marching against everything (static and deforming)"),
+    Choice("far", "Sphere Proxies", "only the sphere proxies of characters (fast, coarse)"),
+    Choice("hao+far", "Voxels + Spheres", "spheres for meshes that have proxies, voxels for the rest "
+                                          "(each occluder counted once)"),
+    Choice("near", "Near Field", "image-space AO from the two depth layers within the distance "
+                                 "(rays = samples per pixel); misses what is off screen"),
+    Choice("near+far", "Near Field + Spheres", "near field plus the sphere proxies (the paper's combination)"),
+)
+METHODS = tuple(c.value for c in METHOD_CHOICES)
 
 
 @dataclass(frozen=True)
 class ViewAOSettings:
-    rays: int = 32             # rays per AO-map pixel (regular pattern, jittered in object space)
-    steps: int = 8             # fixed occupancy tests per ray
-    spread: float = 1.0        # cone of the rays: 1 = whole hemisphere (the AO definition)
-    max_distance: float = 1.0  # d_max, world units: Wendland support of the hit distance
-    grid: int = 256            # voxels along the longest side of the region of interest
-    scale: int = 2             # AO map is 1/scale of the screen per axis (k)
-    filter_size: int = 16      # bilateral window m (full-resolution pixels)
-    strength: float = 1.0      # viewport only: 0 = no darkening, 1 = the computed AO
-    method: str = "hao"
-    epsilon: float = 0.05      # sphere influence cut-off (A_psi units, paper eq. 5): d_far ~ 7.9 r
+    rays: int = setting(32, label="Rays", minimum=1, maximum=1024, soft_max=128,
+                        description="rays per AO-map pixel; the main cost (paper default 32)")
+    steps: int = setting(8, label="Steps", minimum=1, maximum=256, soft_max=32,
+                         description="fixed occupancy tests along each ray (paper default 8)")
+    spread: float = setting(1.0, label="Spread", minimum=0.05, maximum=1.0,
+                            description="cone of the rays: 1 = the whole hemisphere (the AO definition); "
+                                        "smaller gives sharper, more contrasted AO")
+    max_distance: float = setting(1.0, label="Distance", noun="max distance", minimum=0.0, above_minimum=True,
+                                  soft_max=100.0, unit="scene units", subtype='DISTANCE',
+                                  description="the maximum distance d_max: occluders farther than this do not darken; closer ones "
+                                              "fade in smoothly (Wendland kernel)")
+    grid: int = setting(256, label="Grid", minimum=GRID_MIN, maximum=GRID_MAX, unit="voxels",
+                        description="voxels along the longest side of the region of interest")
+    scale: int = setting(2, label="AO Scale", noun="scale", minimum=1, maximum=8,
+                         description="AO is sampled at 1/scale of the image resolution per axis, then "
+                                     "upsampled by the bilateral filter")
+    filter_size: int = setting(16, label="Filter", noun="filter size", minimum=0, maximum=64, unit="pixels",
+                               cli="--filter", description="bilateral filter window (0 = off)")
+    strength: float = setting(1.0, label="Strength", minimum=0.0, maximum=1.0, subtype='FACTOR', cli=None,
+                              description="how much the viewport is darkened (1 = the computed AO)")
+    method: str = setting("hao", label="Method", choices=METHOD_CHOICES, description="what casts the AO")
+    epsilon: float = setting(0.05, label="Sphere Cut-off", noun="epsilon", minimum=0.0, above_minimum=True,
+                             maximum=0.99, description="occlusion below which a sphere proxy stops influencing "
+                                                       "(the paper's epsilon): smaller reaches farther")
 
     def validated(self) -> "ViewAOSettings":
-        """Self, or BakeInputError naming the first bad value."""
-        checks = [
-            (1 <= self.rays <= 1024, f"rays must be 1..1024, got {self.rays}"),
-            (1 <= self.steps <= 256, f"steps must be 1..256, got {self.steps}"),
-            (0.05 <= self.spread <= 1.0, f"spread must be 0.05..1, got {self.spread}"),
-            (self.max_distance > 0.0 and self.max_distance < float("inf"),
-             f"max distance must be a positive number, got {self.max_distance}"),
-            (GRID_MIN <= self.grid <= GRID_MAX, f"grid must be {GRID_MIN}..{GRID_MAX}, got {self.grid}"),
-            (1 <= self.scale <= 8, f"scale must be 1..8, got {self.scale}"),
-            (0 <= self.filter_size <= 64, f"filter size must be 0..64, got {self.filter_size}"),
-            (0.0 <= self.strength <= 1.0, f"strength must be 0..1, got {self.strength}"),
-            (self.method in METHODS, f"method must be one of {', '.join(METHODS)}, got '{self.method}'"),
-            (0.0 < self.epsilon < 1.0, f"epsilon must be in (0, 1), got {self.epsilon}"),
-        ]
-        for ok, message in checks:
-            if not ok:
-                raise BakeInputError(message)
+        """Self, or SettingError naming the first bad value."""
+        validate(self)
         return self
 
     def with_(self, **changes) -> "ViewAOSettings":
         return replace(self, **changes)
+
+
+# GPU bytes per full-resolution pixel: a G-buffer layer (RGBA32F position and normal, 32-bit
+# depth: 36 B; the near field adds a back layer) and the filter's two R32F images (8 B); per
+# AO-map pixel the low-resolution G-buffer (36 B) and AO (4 B).
+GBUFFER_LAYER_BYTES, FILTER_BYTES, BYTES_PER_AO_PIXEL = 36, 8, 40
+
+
+def render_gpu_bytes(width: int, height: int, settings: ViewAOSettings) -> int:
+    """Estimate of the GPU memory a width x height frame takes (images and voxel grid)."""
+    low = -(-width // settings.scale) * -(-height // settings.scale)
+    layers = 2 if "near" in settings.method else 1
+    full = width * height * (layers * GBUFFER_LAYER_BYTES + FILTER_BYTES)
+    return full + low * BYTES_PER_AO_PIXEL + settings.grid ** 3 // 8
+
+
+@dataclass(frozen=True)
+class RenderSize:
+    """Image size of a camera render (render-ao; the operator takes the scene's resolution)."""
+
+    width: int = setting(800, label="Width", minimum=1, maximum=MAX_RENDER_SIDE, unit="pixels", ui=False,
+                         description="image width (also limited by the GPU's texture size and memory budget)")
+    height: int = setting(600, label="Height", minimum=1, maximum=MAX_RENDER_SIDE, unit="pixels", ui=False,
+                          description="image height")
+
+    def validated(self) -> "RenderSize":
+        validate(self)
+        return self

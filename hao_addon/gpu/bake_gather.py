@@ -23,7 +23,8 @@ import numpy as np
 
 from ..core.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
-from ..core.plan import BakeInputError, BakePlan
+from ..core.errors import BakeInputError
+from ..core.plan import BakePlan
 from . import util
 from .light_view import LightViewBaker, depth_prepass, plan_batch
 from .shaders import cached_shader, glsl_source

@@ -19,7 +19,7 @@ from collections import Counter
 import gpu
 import numpy as np
 
-from ..core.plan import BakeInputError
+from ..core.errors import BakeInputError
 from ..core.view_scene import SceneObject, render_anchor, scene_bounds
 from ..core.view_settings import ViewAOSettings
 from ..core.voxel_grid import GridSpec, dominant_axes, grid_for_bounds

@@ -50,16 +50,31 @@ def gpu_memory_budget() -> int:
 
 def check_texture_limits(map_size: int, view_side: int, bytes_needed: int) -> None:
     """Raise BakeInputError when a bake exceeds the GPU's texture size or the memory budget."""
-    from ..core.plan import BakeInputError
+    from ..core.errors import BakeInputError
     limit = gpu.capabilities.max_texture_size_get()
     if map_size > limit:
         raise BakeInputError(f"map size {map_size} exceeds this GPU's texture limit of {limit}")
     if view_side > limit:
         raise BakeInputError(f"the light views need {view_side} pixels per side, above this GPU's "
                              f"limit of {limit}: lower the view samples per texel or the map size")
+    _check_budget(bytes_needed, "the bake")
+
+
+def check_render_limits(width: int, height: int, bytes_needed: int) -> None:
+    """Raise BakeInputError when a width x height render exceeds the GPU's texture size or the
+    memory budget (checked before any texture is made)."""
+    from ..core.errors import BakeInputError
+    limit = gpu.capabilities.max_texture_size_get()
+    if max(width, height) > limit:
+        raise BakeInputError(f"a {width}x{height} image exceeds this GPU's texture limit of {limit} pixels per side")
+    _check_budget(bytes_needed, f"a {width}x{height} render")
+
+
+def _check_budget(bytes_needed: int, what: str) -> None:
+    from ..core.errors import BakeInputError
     budget = gpu_memory_budget()
     if bytes_needed > budget:
-        raise BakeInputError(f"the bake needs about {bytes_needed / 2**20:.0f} MiB of GPU memory, above the "
+        raise BakeInputError(f"{what} needs about {bytes_needed / 2**20:.0f} MiB of GPU memory, above the "
                              f"budget of {budget / 2**20:.0f} MiB (set HAO_GPU_MEMORY_BUDGET to raise it)")
 
 

@@ -1,0 +1,23 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Output paths as Blender users write them: '//' relative to the .blend file, '{object}'."""
+from __future__ import annotations
+
+import bpy
+
+from ..core.errors import BakeInputError
+
+OBJECT_TOKEN = "{object}"
+
+
+def absolute_path(path: str) -> str:
+    """Blender's abspath, refusing '//' paths while the .blend file has no location (they would
+    silently land in the process's working directory)."""
+    if path.startswith("//") and not bpy.data.filepath:
+        raise BakeInputError(f"'{path}' is relative to the .blend file ('//'), which is not saved yet: "
+                             f"save the file first or give an absolute path")
+    return bpy.path.abspath(path)
+
+
+def object_file_name(obj) -> str:
+    """The object's name as it appears in file names (Blender's clean_name)."""
+    return bpy.path.clean_name(obj.name)

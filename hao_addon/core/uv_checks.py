@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""UV layouts that bake, but not as the user probably expects: islands that overlap (their
+texels receive the average of several surface points) and UVs outside the 0..1 tile (those
+parts are not baked). Both are reported as warnings, as Cycles users would want to know."""
+from __future__ import annotations
+
+import numpy as np
+
+# Overlaps are counted at texel centres of a map at most this large (cost ~ UV area x side^2).
+CHECK_SIDE = 1024
+# Fractions below these are rounding at shared edges, not a layout problem.
+OVERLAP_WARN_FRACTION = 1e-3
+CHUNK_CANDIDATES = 1 << 21
+
+
+def texel_centre_hits(uvs: np.ndarray, side: int) -> np.ndarray:
+    """(side, side) int32: how many UV triangles strictly contain each texel centre.
+
+    uvs: (F, 3, 2). Vectorized: every texel centre of each face's box is tested once, in
+    chunks of faces whose boxes hold about CHUNK_CANDIDATES centres (bounded memory)."""
+    p = np.asarray(uvs, np.float64) * side - 0.5
+    lo = np.clip(np.ceil(p.min(axis=1)), 0, side - 1).astype(np.int64)
+    hi = np.clip(np.floor(p.max(axis=1)), 0, side - 1).astype(np.int64)
+    w = np.maximum(hi[:, 0] - lo[:, 0] + 1, 0)
+    h = np.maximum(hi[:, 1] - lo[:, 1] + 1, 0)
+    ends = np.cumsum(w * h)
+    hits = np.zeros(side * side, np.int32)
+    cuts = np.searchsorted(ends, np.arange(CHUNK_CANDIDATES, int(ends[-1]) if len(ends) else 0, CHUNK_CANDIDATES))
+    for faces in np.split(np.arange(len(p)), np.unique(cuts)):
+        if len(faces):
+            _count_chunk(p[faces], lo[faces], w[faces], h[faces], side, hits)
+    return hits.reshape(side, side)
+
+
+def _count_chunk(p, lo, w, h, side, hits) -> None:
+    counts = w * h
+    total = int(counts.sum())
+    if total == 0:
+        return
+    face = np.repeat(np.arange(len(p)), counts)
+    local = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    xs = lo[face, 0] + local % w[face]
+    ys = lo[face, 1] + local // w[face]
+    a, b, c = p[face, 0], p[face, 1], p[face, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w1 = ((xs - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (ys - a[:, 1])) / det
+        w2 = ((b[:, 0] - a[:, 0]) * (ys - a[:, 1]) - (xs - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+    eps = 1e-7
+    inside = (np.abs(det) > 1e-12) & (w1 > eps) & (w2 > eps) & (1.0 - w1 - w2 > eps)
+    np.add.at(hits, ys[inside] * side + xs[inside], 1)
+
+
+def uv_layout_warnings(uvs: np.ndarray, size: int, name: str) -> tuple[list[str], dict]:
+    """Warnings (sentences) and counters for a bake target's UV layout. uvs: (F, 3, 2)."""
+    # Less than half a texel past the tile's edge, no texel centre is missed.
+    tolerance = 0.5 / size
+    outside = ((uvs < -tolerance) | (uvs > 1.0 + tolerance)).any(axis=(1, 2))
+    side = min(int(size), CHECK_SIDE)
+    hits = texel_centre_hits(uvs, side)
+    covered = int((hits > 0).sum())
+    overlapped = int((hits > 1).sum())
+    fraction = overlapped / covered if covered else 0.0
+    warnings = []
+    if outside.any():
+        warnings.append(f"'{name}': {int(outside.sum())} of {len(uvs)} UV triangles reach outside the 0..1 UV "
+                        f"tile; those parts are not baked")
+    if fraction > OVERLAP_WARN_FRACTION:
+        warnings.append(f"'{name}': UV islands overlap on {fraction * 100:.1f} % of the baked texels; "
+                        f"those texels get the average of the overlapping surfaces")
+    counters = dict(uv_triangles_outside_tile=int(outside.sum()), uv_overlap_fraction=fraction)
+    return warnings, counters

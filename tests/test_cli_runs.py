@@ -1,0 +1,223 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The command line as a pipeline uses it: quiet runs print nothing, --json reports, progress on
+a terminal, {object} names, and Ctrl-C / SIGTERM stop any phase at once, leaving nothing."""
+from __future__ import annotations
+
+import json
+import os
+import pty
+import select
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+
+SPOT = ROOT / "samples" / "spot.obj"
+BUNNY = ROOT / "bench" / "data" / "stanford-bunny.obj"  # no UVs: xatlas takes ~20 s on it
+
+
+def env_for(tmp: Path) -> dict:
+    return {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp), "TEMP": str(tmp), "TMP": str(tmp)}
+
+
+def run(args, tmp: Path, **kw):
+    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
+                          env=env_for(tmp), cwd=tmp, timeout=600, **kw)
+
+
+@pytest.fixture
+def dirs(tmp_path):
+    out, tmp = tmp_path / "out", tmp_path / "tmp"
+    out.mkdir()
+    tmp.mkdir()
+    return out, tmp
+
+
+def test_quiet_success_prints_nothing_at_all(dirs, tmp_path):
+    out, tmp = dirs
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / "a.png", "--quiet"], tmp)
+    assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == "", proc.stderr
+    blend = tmp_path / "scene.blend"
+    script = (f"import bpy; bpy.ops.wm.read_factory_settings(use_empty=True); bpy.ops.mesh.primitive_monkey_add();"
+              f"bpy.ops.object.camera_add(location=(0, -5, 0), rotation=(1.5708, 0, 0));"
+              f"bpy.context.scene.camera = bpy.context.active_object;"
+              f"bpy.ops.wm.save_as_mainfile(filepath=r'{blend}')")
+    assert subprocess.run([sys.executable, "-c", script], capture_output=True).returncode == 0
+    proc = run(["render-ao", blend, "--width", "64", "--height", "48", "--out", out / "r.png", "--quiet"], tmp)
+    assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == "", proc.stderr
+    # Without --quiet: our own summary line only (no importer log, no EGL or driver lines).
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / "b.png"], tmp)
+    assert proc.returncode == 0 and proc.stdout.count("\n") == 1 and proc.stdout.startswith("hao: baked 'spot'")
+    assert all(line.startswith("hao: warning: ") for line in proc.stderr.splitlines()), proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["a.png", "b.png", "r.png"] and list(tmp.iterdir()) == []
+
+
+def test_object_token_and_json_report(dirs):
+    out, tmp = dirs
+    report = out / "report.json"
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / "{object}_ao.exr",
+                "--json", report, "--quiet"], tmp)
+    assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == "", proc.stderr
+    assert (out / "spot_ao.exr").is_file() and not list(out.glob("{*"))
+    data = json.loads(report.read_text())
+    assert data["status"] == "ok" and data["exit_code"] == 0 and data["error"] is None
+    assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
+    assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
+                                    covered_texels=data["objects"][0]["covered_texels"], method="gather")]
+    assert data["settings"]["size"] == 64 and data["settings"]["view_samples"] == 2.0
+    assert {"load", "bake", "write", "total", "unwrap"} <= set(data["timings"])
+    assert any("outside the 0..1 UV tile" in w for w in data["warnings"])  # Spot's UVs reach past 0
+    # '-' writes the report to stdout, and a failure is reported too (with nothing else written).
+    proc = run(["bake", SPOT, "--size", "8", "--out", out / "x.png", "--json", "-"], tmp)
+    data = json.loads(proc.stdout)
+    assert proc.returncode == 2 and data["status"] == "error" and "map size" in data["error"]
+    assert data["exit_code"] == 2 and data["outputs"] == [] and not (out / "x.png").exists()
+    assert "bake" not in data["timings"] and "load" not in data["timings"]  # refused before any work
+
+
+def test_output_checks_come_before_any_work(dirs):
+    """A legal 254-byte name bakes (the temporary name is short); a missing folder fails
+    before the scene is loaded or the GPU is touched."""
+    out, tmp = dirs
+    name = "a" * 250 + ".png"
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / name, "--quiet"], tmp)
+    assert proc.returncode == 0 and (out / name).is_file(), proc.stderr
+    report = out / "r.json"
+    for command in (["bake", SPOT, "--size", "64"], ["render-ao", ROOT / "tests" / "data" / "CesiumMan.glb"]):
+        proc = run([*command, "--out", out / "missing" / "x.png", "--json", report], tmp)
+        data = json.loads(report.read_text())
+        assert proc.returncode == 2 and "folder does not exist" in proc.stderr
+        assert set(data["timings"]) == {"total"}, data["timings"]
+
+
+def test_unwrap_warnings_for_overlapping_and_outside_uvs(tmp_path):
+    import numpy as np
+
+    from hao_addon.core.uv_checks import uv_layout_warnings
+    from hao_addon.core import scenes
+    plane = scenes.grid_plane(2.0, 8)
+    assert uv_layout_warnings(plane.uvs, 256, "p")[0] == []
+    doubled = np.concatenate([plane.uvs, plane.uvs * 0.5])
+    warnings, counters = uv_layout_warnings(doubled, 256, "p")
+    assert len(warnings) == 1 and "overlap" in warnings[0] and counters["uv_overlap_fraction"] > 0.2
+    shifted = plane.uvs + [0.25, 0.0]
+    warnings, counters = uv_layout_warnings(shifted, 256, "p")
+    assert len(warnings) == 1 and "outside the 0..1" in warnings[0] and counters["uv_triangles_outside_tile"] > 0
+    # Less than half a texel past the edge is not outside (no texel centre is missed).
+    assert uv_layout_warnings(plane.uvs * (1 + 0.4 / 256), 256, "p")[0] == []
+
+
+# -- progress and interrupts ------------------------------------------------------------------------
+
+def start_on_pty(args, tmp: Path):
+    """Start the CLI with stderr on a pseudo-terminal (as in an interactive shell)."""
+    master, slave = pty.openpty()
+    proc = subprocess.Popen([sys.executable, "-m", "hao_addon", *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=slave, stdin=subprocess.DEVNULL, env=env_for(tmp), cwd=tmp)
+    os.close(slave)
+    return proc, master
+
+
+def read_until(master: int, proc, needle: str, timeout: float) -> str:
+    text, end = "", time.monotonic() + timeout
+    while needle not in text and time.monotonic() < end and proc.poll() is None:
+        ready, _, _ = select.select([master], [], [], 0.1)
+        if ready:
+            try:
+                text += os.read(master, 4096).decode(errors="replace")
+            except OSError:
+                break
+    return text
+
+
+def drain(master: int) -> str:
+    text = ""
+    while select.select([master], [], [], 0.2)[0]:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        text += chunk.decode(errors="replace")
+    return text
+
+
+def children_of(pid: int) -> list[int]:
+    try:
+        return [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+    except OSError:
+        return []
+
+
+def test_progress_on_a_terminal_and_not_when_quiet(dirs):
+    out, tmp = dirs
+    args = ["bake", SPOT, "--size", "256", "--directions", "2048", "--out", out / "a.png"]
+    proc, master = start_on_pty(args, tmp)
+    try:
+        text = read_until(master, proc, "s left)", timeout=120)
+        proc.wait(timeout=600)
+        text += drain(master)
+    finally:
+        os.close(master)
+    assert proc.returncode == 0
+    assert "hao: Baking AO of 'spot'" in text and "% (" in text and "s left)" in text, text[-500:]
+    proc, master = start_on_pty([*args[:-2], "--out", out / "b.png", "--quiet"], tmp)
+    try:
+        proc.wait(timeout=600)
+        text = drain(master)
+    finally:
+        os.close(master)
+    assert proc.returncode == 0 and text == ""
+
+
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
+                                                (signal.SIGTERM, 143, "terminated")])
+def test_signal_during_unwrap_stops_at_once(dirs, signum, code, word):
+    out, tmp = dirs
+    proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", BUNNY, "--size", "512", "--directions", "8",
+                             "--out", out / "a.png"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=env_for(tmp), cwd=tmp, text=True)
+    end = time.monotonic() + 60
+    while not children_of(proc.pid) and time.monotonic() < end and proc.poll() is None:
+        time.sleep(0.05)
+    workers = children_of(proc.pid)
+    assert workers, "the xatlas child never started"
+    time.sleep(0.5)  # well inside the unwrap (about 20 s for the bunny)
+    t0 = time.monotonic()
+    proc.send_signal(signum)
+    stdout, stderr = proc.communicate(timeout=30)
+    elapsed = time.monotonic() - t0
+    assert elapsed < 2.0, elapsed
+    assert proc.returncode == code, stderr
+    assert stderr.splitlines() == [f"hao: error: {word} (SIG{signum.name[3:]}): nothing was written"], stderr
+    assert stdout == "" and list(out.iterdir()) == [] and list(tmp.iterdir()) == []
+    assert not any(Path(f"/proc/{w}").exists() and "zombie" not in Path(f"/proc/{w}/status").read_text()
+                   for w in workers)
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_during_bake_stops_at_once(dirs, signum, code):
+    out, tmp = dirs
+    proc, master = start_on_pty(["bake", SPOT, "--size", "512", "--directions", "8192", "--out", out / "a.png",
+                                 "--json", out.parent / "report.json"], tmp)
+    try:
+        text = read_until(master, proc, "Baking AO", timeout=120)
+        assert "Baking AO" in text, text
+        t0 = time.monotonic()
+        proc.send_signal(signum)
+        proc.wait(timeout=30)
+        elapsed = time.monotonic() - t0
+        text += drain(master)
+    finally:
+        os.close(master)
+    assert elapsed < 2.0 and proc.returncode == code, (elapsed, proc.returncode)
+    assert text.replace("\x1b[K", "").replace("\r", "\n").strip().splitlines()[-1].startswith("hao: error: ")
+    report = json.loads((out.parent / "report.json").read_text())
+    assert report["status"] == "interrupted" and report["exit_code"] == code
+    assert list(out.iterdir()) == [] and list(tmp.iterdir()) == []
