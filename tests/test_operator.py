@@ -276,3 +276,17 @@ def test_uv_layout_problems_are_reported_as_warnings(scene, capfd):
     assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
     out = capfd.readouterr().out
     assert "Warning: 'Suzanne':" in out and "outside the 0..1 UV tile" in out, out
+
+
+@pytest.mark.parametrize("scale", [1e-5, 1e10])
+def test_tiny_and_huge_meshes_without_uvs_bake(scene, scale):
+    # xatlas unwraps a unit-size copy: 1e10 units used to hang in it, 1e-5 packed no atlas.
+    bpy.ops.mesh.primitive_cube_add(size=2.0 * scale)
+    obj = bpy.context.active_object
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    small_settings(scene, uv_mode='AUTO')
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert [l.name for l in obj.data.uv_layers] == ["AO_UV"]
+    px = np.empty(128 * 128 * 4, np.float32)
+    bpy.data.images[f"{obj.name}_AO"].pixels.foreach_get(px)
+    assert np.isfinite(px).all() and px.reshape(-1, 4)[:, 0].max() == 1.0  # a lone convex cube is open
