@@ -18,7 +18,8 @@ from dataclasses import asdict
 from pathlib import Path
 
 from . import __version__
-from .cli_io import EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, signals_as_exceptions
+from .cli_io import (EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, check_signals,
+                     deferred_signals, signals_as_exceptions)
 from .cli_options import add_setting_options, option_for, settings_from_args
 from .core.errors import BakeInputError
 from .core.setting_spec import SettingError
@@ -118,6 +119,7 @@ def load_scene(path: Path) -> None:
         else:
             bpy.ops.import_scene.gltf(filepath=str(path))
     except (RuntimeError, ValueError, KeyError, OSError, UnicodeError) as exc:  # the importers' own errors
+        check_signals()  # a Python importer interrupted by Ctrl-C fails with Blender's RuntimeError
         raise CLIError(f"cannot read '{path.name}': {_last_line(exc)}") from None
 
 
@@ -162,17 +164,20 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
+    check_signals()
     target = pick_target(args.object)
     request = BakeRequest(targets=[target], settings=settings,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                           filepath=str(Path(os.path.abspath(args.out))), source_path=str(source))
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
+    start_gpu()
     t0 = time.perf_counter()
     try:
         with report.phase("bake"):
             for fraction, text in job.steps():
                 progress.update(text.split(":")[0], fraction if fraction > 0 else None)
+        check_signals()  # never commit a run that was asked to stop
         with report.phase("write"):
             job.commit()
     except BaseException:
@@ -213,6 +218,7 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
+    check_signals()
     scene = bpy.context.scene
     if args.frame is not None:
         scene.frame_set(args.frame)
@@ -231,16 +237,26 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
         with report.phase("spheres"):
             for obj in rigged:
                 make_proxies(obj, args.spheres)
+    start_gpu()
     t0 = time.perf_counter()
     with report.phase("render"):
         progress.update("rendering")
         rgba = render_camera_ao(scene, camera, size.width, size.height, settings, skip_baked=args.skip_baked)
+    check_signals()
     with report.phase("write"):
         write_ao_file(out, rgba)
     report.objects.append(dict(camera=camera.name))
     report.outputs.append(str(out))
     return [f"hao: rendered AO from '{camera.name}' {size.width}x{size.height} in "
             f"{time.perf_counter() - t0:.2f} s -> {out}"]
+
+
+def start_gpu() -> None:
+    """Blender's GPU context, made while signals wait (an interrupt inside its creation, which
+    runs Python callbacks from C, is not safe)."""
+    from .gpu.context import ensure_gpu_context
+    with deferred_signals():
+        ensure_gpu_context()
 
 
 def _validated(settings, settings_cls):
@@ -265,7 +281,8 @@ def main(argv: list[str] | None = None) -> int:
         args = None
         try:
             args = _parse(argv, io)
-            import bpy
+            with deferred_signals():
+                import bpy
             report.blender = bpy.app.version_string
             progress = Progress(io.err, enabled=io.err_is_terminal and not args.quiet)
             try:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import sys
 import tempfile
@@ -57,6 +58,28 @@ class ProcessOutput:
         self._log.close()
 
 
+# Signals received and not yet acted on. Blender prints and swallows an exception raised in
+# Python code it calls back (an importer's callback, a property update): a KeyboardInterrupt
+# that lands there would be lost, so the signal is also recorded here, and every progress
+# step (check_signals) raises it again until the run stops.
+_PENDING: list[int] = []
+# While positive, a signal is only recorded: raising inside Blender's own initialization
+# (``import bpy``, the first GPU context) crashes it (SIGSEGV seen with bpy 5.1).
+_DEFER = [0]
+
+
+def _raise_for(signum: int) -> None:
+    if signum == signal.SIGTERM:
+        raise Terminated()
+    raise KeyboardInterrupt()
+
+
+def check_signals() -> None:
+    """Raise for a signal that arrived and was swallowed on its way (see _PENDING)."""
+    if _PENDING:
+        _raise_for(_PENDING[0])
+
+
 @contextlib.contextmanager
 def signals_as_exceptions() -> Iterator[None]:
     """SIGINT raises KeyboardInterrupt and SIGTERM raises Terminated while inside (the main
@@ -65,16 +88,47 @@ def signals_as_exceptions() -> Iterator[None]:
         yield
         return
 
-    def on_term(signum, frame):
-        raise Terminated()
+    def on_signal(signum, frame):
+        _PENDING.append(signum)
+        if not _DEFER[0]:
+            _raise_for(signum)
 
-    previous = {signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
-                signal.SIGTERM: signal.signal(signal.SIGTERM, on_term)}
+    _PENDING.clear()
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        _PENDING.clear()
+
+
+@contextlib.contextmanager
+def deferred_signals() -> Iterator[None]:
+    """Run Blender code that must not be interrupted half-way; a signal that arrives meanwhile
+    is raised right after it."""
+    _DEFER[0] += 1
+    try:
+        yield
+    finally:
+        _DEFER[0] -= 1
+    if not _DEFER[0]:
+        check_signals()
+
+
+def exit_process(code: int) -> None:
+    """End ``python -m hao_addon`` with exactly this code. bpy's interpreter teardown can
+    crash (bpy 4.2 after some registrations, see compat; a signal during a run can leave it
+    unsafe), so the process ends at once, after what that teardown would have done for us:
+    flushing the streams and removing Blender's session temporary folder."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    bpy = sys.modules.get("bpy")
+    if bpy is not None:
+        folder = os.path.normpath(getattr(bpy.app, "tempdir", "") or "")
+        if os.path.basename(folder).startswith("blender_") and os.path.isdir(folder):
+            shutil.rmtree(folder, ignore_errors=True)
+    os._exit(code)
 
 
 class Progress:
@@ -94,7 +148,9 @@ class Progress:
         self._phase_start = self.start
 
     def update(self, phase: str, fraction: float | None = None) -> None:
-        """phase: what runs now; fraction: of that phase, in [0, 1], or None if unknown."""
+        """phase: what runs now; fraction: of that phase, in [0, 1], or None if unknown.
+        Also where a swallowed signal is raised again (check_signals)."""
+        check_signals()
         now = time.perf_counter()
         if phase != self._phase:
             self._phase, self._phase_start = phase, now
@@ -105,9 +161,9 @@ class Progress:
         if fraction is not None and fraction > 0.0:
             left = (now - self._phase_start) * (1.0 - fraction) / fraction
             text += f" {fraction * 100:3.0f}% ({left:.1f} s left)"
+        self._shown = True  # first: a signal during the write must still get the line cleared
         self.stream.write("\r\033[K" + text)
         self.stream.flush()
-        self._shown = True
 
     def finish(self) -> None:
         if self._shown:

@@ -114,3 +114,12 @@ def select_only(*objs) -> None:
         o.select_set(True)
     if objs:
         bpy.context.view_layer.objects.active = objs[0]
+
+
+def small_settings(scene, **kw):
+    """A small, quick bake (128^2, 32 directions, margin 4) with the given overrides."""
+    s = scene.hao_bake
+    s.size, s.directions, s.margin = 128, 32, 4
+    for k, v in kw.items():
+        setattr(s, k, v)
+    return s

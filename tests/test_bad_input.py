@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 import bpy
-from conftest import ROOT, select_only
+from conftest import ROOT, select_only, small_settings
 
 SPOT = ROOT / "samples" / "spot.obj"
 
@@ -267,13 +267,6 @@ def two_cubes(*names):
     return objs
 
 
-def small(scene, **kw):
-    s = scene.hao_bake
-    s.size, s.directions, s.margin = 64, 8, 2
-    for k, v in kw.items():
-        setattr(s, k, v)
-
-
 @pytest.mark.parametrize("setup, message", [
     ("colliding-names", "would both be saved as"),
     ("relative-path-unsaved", "relative to the .blend file"),
@@ -286,19 +279,19 @@ def small(scene, **kw):
 def test_bake_operator_bad_input(scene, tmp_path, setup, message):
     a, b = two_cubes("a b", "a_b")
     if setup == "colliding-names":
-        small(scene, filepath=str(tmp_path / "pair.png"))
+        small_settings(scene, filepath=str(tmp_path / "pair.png"))
     elif setup == "relative-path-unsaved":
         assert bpy.data.filepath == ""
-        small(scene, filepath="//ao.png")
+        small_settings(scene, filepath="//ao.png")
     elif setup == "unsupported-extension":
-        small(scene, filepath=str(tmp_path / "ao.bmp"))
+        small_settings(scene, filepath=str(tmp_path / "ao.bmp"))
     elif setup == "missing-uv-map":
-        small(scene, uv_mode='NAMED', uv_map="Nope")
+        small_settings(scene, uv_mode='NAMED', uv_map="Nope")
     elif setup == "nan-vertex":
         b.data.vertices[0].co = (float("nan"), 0.0, 0.0)
-        small(scene)
+        small_settings(scene)
     elif setup == "name-too-long":
-        small(scene, filepath=str(tmp_path / ("x" * 300 + ".png")))
+        small_settings(scene, filepath=str(tmp_path / ("x" * 300 + ".png")))
     elif setup == "nothing-selected":
         select_only()
     before = scene_state()

@@ -172,3 +172,23 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
     assert (maps[0] < 0.9).sum() > 50  # the plane shades the sphere's underside
     assert stats[0]["texel_tests_skipped"] > 0.1 * (stats[0]["texel_tests"] + stats[0]["texel_tests_skipped"])
     assert stats[1]["texel_tests_skipped"] == 0
+
+
+def test_wendland_falloff_is_the_papers_kernel(gpu_context):
+    """The scatter's falloff is w(x) = (1 - x)^4 (4x + 1), not a kernel of the same shape:
+    with d_max past the floor's far edge the weight matters at every texel, and at D = 1024
+    the bias bound is five times smaller than what (1 - x)^4 (3x + 1) would add."""
+    floor, wall = floor_and_wall(width=20.0, height=10.0)  # a wall that is infinite within reach
+    size, directions, max_distance = 128, 1024, 4.0
+    res = bake(floor, [wall], BakeSettings(size=size, directions=directions, max_distance=max_distance,
+                                           falloff="wendland", margin=0, method="scatter"), use_cache=False)
+    pts, mask = texel_points(floor, size)
+    xs = -pts[..., 0].ravel()
+    ref = scenes.wall_accessibility(xs, max_distance, "wendland").reshape(size, size)
+    assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, "wendland")
+    # The check is sharp enough: the same formula with 3x + 1 fails it by bias alone.
+    y = (np.arange(4096) + 0.5) / 4096
+    s = np.clip(xs[:, None] / y[None, :] / max_distance, 0.0, 1.0)
+    extra = ((1.0 - s) ** 4 * s * 2.0 * np.sqrt(1.0 - y * y)).sum(axis=1) / 4096 / np.pi  # w4 - w3
+    mutant = (ref.ravel() + extra).reshape(size, size)
+    assert error_stats(mutant, ref, mask & res.covered)["bias"] > 4 * sigma(directions) / 8

@@ -110,6 +110,9 @@ def test_unwrap_warnings_for_overlapping_and_outside_uvs(tmp_path):
     assert len(warnings) == 1 and "outside the 0..1" in warnings[0] and counters["uv_triangles_outside_tile"] > 0
     # Less than half a texel past the edge is not outside (no texel centre is missed).
     assert uv_layout_warnings(plane.uvs * (1 + 0.4 / 256), 256, "p")[0] == []
+    # The same UVs again (a re-bake with other settings): the raster is skipped, same answer.
+    again, counters = uv_layout_warnings(shifted, 256, "p")
+    assert counters["uv_check_cached"] and again == warnings
 
 
 # -- progress and interrupts ------------------------------------------------------------------------
@@ -220,4 +223,23 @@ def test_signal_during_bake_stops_at_once(dirs, signum, code):
     assert text.replace("\x1b[K", "").replace("\r", "\n").strip().splitlines()[-1].startswith("hao: error: ")
     report = json.loads((out.parent / "report.json").read_text())
     assert report["status"] == "interrupted" and report["exit_code"] == code
+    assert list(out.iterdir()) == [] and list(tmp.iterdir()) == []
+
+
+@pytest.mark.parametrize("delay", [0.15, 0.3, 0.6, 0.9, 1.2, 1.6])
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_at_any_moment_stops_cleanly(dirs, delay, signum, code):
+    """Start-up (from 0.15 s: before that Python itself is still starting), `import bpy`, the glTF importer (Python), GPU context creation, the bake: a
+    signal anywhere gives the same clean exit (bpy 5.1 crashed when one landed inside its
+    initialization; Blender swallowed one that landed in an importer callback)."""
+    out, tmp = dirs
+    proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", ROOT / "tests" / "data" / "CesiumMan.glb",
+                             "--size", "256", "--directions", "16384", "--out", out / "a.png"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env_for(tmp), cwd=tmp, text=True)
+    time.sleep(delay)
+    t0 = time.monotonic()
+    proc.send_signal(signum)
+    _stdout, stderr = proc.communicate(timeout=60)
+    assert time.monotonic() - t0 < 2.0 and proc.returncode == code, (proc.returncode, stderr)
+    assert len(stderr.splitlines()) == 1 and stderr.startswith("hao: error: "), stderr
     assert list(out.iterdir()) == [] and list(tmp.iterdir()) == []

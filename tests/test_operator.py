@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import select_only, soup_to_object
+from conftest import select_only, small_settings, soup_to_object
 from hao_addon.core import scenes
 from hao_addon.gpu.util import live_pass_count, snapshot_state
 
@@ -21,14 +21,6 @@ def monkey():
     bpy.ops.mesh.primitive_monkey_add()
     obj = bpy.context.active_object
     return obj
-
-
-def small_settings(scene, **kw):
-    s = scene.hao_bake
-    s.size, s.directions, s.margin = 128, 32, 4
-    for k, v in kw.items():
-        setattr(s, k, v)
-    return s
 
 
 def test_poll_explains_why_it_is_greyed_out(scene):

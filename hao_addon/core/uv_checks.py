@@ -4,10 +4,13 @@ texels receive the average of several surface points) and UVs outside the 0..1 t
 parts are not baked). Both are reported as warnings, as Cycles users would want to know."""
 from __future__ import annotations
 
+import hashlib
+from collections import OrderedDict
+
 import numpy as np
 
 # Overlaps are counted at texel centres of a map at most this large (cost ~ UV area x side^2).
-CHECK_SIDE = 1024
+CHECK_SIDE = 512
 # Fractions below these are rounding at shared edges, not a layout problem.
 OVERLAP_WARN_FRACTION = 1e-3
 CHUNK_CANDIDATES = 1 << 21
@@ -48,25 +51,43 @@ def _count_chunk(p, lo, w, h, side, hits) -> None:
         w2 = ((b[:, 0] - a[:, 0]) * (ys - a[:, 1]) - (xs - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
     eps = 1e-7
     inside = (np.abs(det) > 1e-12) & (w1 > eps) & (w2 > eps) & (1.0 - w1 - w2 > eps)
-    np.add.at(hits, ys[inside] * side + xs[inside], 1)
+    hits += np.bincount(ys[inside] * side + xs[inside], minlength=side * side).astype(np.int32)
 
 
 def uv_layout_warnings(uvs: np.ndarray, size: int, name: str) -> tuple[list[str], dict]:
-    """Warnings (sentences) and counters for a bake target's UV layout. uvs: (F, 3, 2)."""
-    # Less than half a texel past the tile's edge, no texel centre is missed.
-    tolerance = 0.5 / size
-    outside = ((uvs < -tolerance) | (uvs > 1.0 + tolerance)).any(axis=(1, 2))
-    side = min(int(size), CHECK_SIDE)
-    hits = texel_centre_hits(uvs, side)
-    covered = int((hits > 0).sum())
-    overlapped = int((hits > 1).sum())
-    fraction = overlapped / covered if covered else 0.0
+    """Warnings (sentences) and counters for a bake target's UV layout. uvs: (F, 3, 2).
+
+    The numbers are cached by the UVs' content (a re-bake with other settings, or of the same
+    map, skips the raster: counter ``uv_check_cached``)."""
+    counts = _layout_counts(np.ascontiguousarray(uvs, np.float64), int(size))
+    outside, fraction = counts["uv_triangles_outside_tile"], counts["uv_overlap_fraction"]
     warnings = []
-    if outside.any():
-        warnings.append(f"'{name}': {int(outside.sum())} of {len(uvs)} UV triangles reach outside the 0..1 UV "
+    if outside:
+        warnings.append(f"'{name}': {outside} of {len(uvs)} UV triangles reach outside the 0..1 UV "
                         f"tile; those parts are not baked")
     if fraction > OVERLAP_WARN_FRACTION:
         warnings.append(f"'{name}': UV islands overlap on {fraction * 100:.1f} % of the baked texels; "
                         f"those texels get the average of the overlapping surfaces")
-    counters = dict(uv_triangles_outside_tile=int(outside.sum()), uv_overlap_fraction=fraction)
-    return warnings, counters
+    return warnings, counts
+
+
+_CACHE: "OrderedDict[tuple, dict]" = OrderedDict()
+_CACHE_SIZE = 16
+
+
+def _layout_counts(uvs: np.ndarray, size: int) -> dict:
+    key = (hashlib.blake2b(uvs.tobytes(), digest_size=16).digest(), uvs.shape, size)
+    if key in _CACHE:
+        _CACHE.move_to_end(key)
+        return {**_CACHE[key], "uv_check_cached": True}
+    # Less than half a texel past the tile's edge, no texel centre is missed.
+    tolerance = 0.5 / size
+    outside = ((uvs < -tolerance) | (uvs > 1.0 + tolerance)).any(axis=(1, 2))
+    hits = texel_centre_hits(uvs, min(size, CHECK_SIDE))
+    covered = int((hits > 0).sum())
+    counts = dict(uv_triangles_outside_tile=int(outside.sum()),
+                  uv_overlap_fraction=int((hits > 1).sum()) / covered if covered else 0.0)
+    _CACHE[key] = counts
+    while len(_CACHE) > _CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return {**counts, "uv_check_cached": False}
