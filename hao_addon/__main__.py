@@ -2,7 +2,6 @@
 """``python -m hao_addon ...`` (see hao_addon.cli)."""
 import os
 import signal
-import sys
 
 
 def _stop_during_startup(signum, frame):

@@ -159,7 +159,6 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
     """Dispatching only the texel-list entries whose normal bin can face a batch's views
     (core/normal_bins.py) gives the same map as testing every entry, and skips entries."""
     import hao_addon.gpu.bake_gather as bake_gather
-    from hao_addon.bake import bake_steps
     sphere = scenes.uv_sphere(1.0, (0.0, 0.0, 1.0), 48, 24)  # normals all round: bins to skip
     settings = BakeSettings(size=64, directions=32, method="gather", margin=0)
     maps, stats = [], []
