@@ -136,3 +136,16 @@ def test_cli_is_registered_as_a_blender_command(addon):
     from hao_ext.operators import cli_command
     assert cli_command._handle is not None
     assert cli_command._cli(["bake", "missing.obj", "--out", "x.png"]) == 2
+
+
+def test_manifest_bundles_xatlas_for_every_supported_python_and_platform():
+    import tomllib  # Python 3.11+
+    manifest = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
+    wheels = [Path(w).name for w in manifest["wheels"]]
+    assert all((ROOT / "wheels" / w).is_file() for w in wheels)
+    tags = {"linux-x64": "manylinux", "macos-arm64": "macosx_11_0_arm64", "macos-x64": "macosx_10_14_x86_64",
+            "windows-x64": "win_amd64"}
+    for python in ("cp311", "cp313"):  # Blender 4.2-5.0 and 5.1-5.2
+        for platform in manifest["platforms"]:
+            assert any(w.startswith(f"xatlas-0.0.11-{python}-{python}-") and tags[platform] in w for w in wheels), \
+                (python, platform)
