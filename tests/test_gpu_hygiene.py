@@ -75,3 +75,18 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
     addon.register()
     assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
     assert [len(h) for h in handler_lists] == counts
+
+
+def test_constants_reach_glsl_from_python_only():
+    """Each constant the GPU and its numpy mirror share is written once, in Python."""
+    from hao_addon.core.ao_pattern import GLSL_DEFINES
+    from hao_addon.gpu.bake_gather import GATHER_VIEWS_DTYPE, VIEWS_PER_DISPATCH
+    from hao_addon.gpu.shaders import SHADER_DIR
+    sources = {p.name: p.read_text() for p in SHADER_DIR.iterdir()}
+    for name, value in GLSL_DEFINES.items():
+        assert not any(f"#define {name}" in s or repr(value) in s for s in sources.values()), name
+    assert "[4]" not in sources["bake_gather_views.glsl"] and "GATHER_MAX_VIEWS" in sources["bake_gather_views.glsl"]
+    # std140 size of GatherViews: VIEWS_PER_DISPATCH mat4 (64 B) and two arrays of vec4 (16 B).
+    assert GATHER_VIEWS_DTYPE.itemsize == VIEWS_PER_DISPATCH * (64 + 16 + 16)
+    assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "omega", "view_info")] == \
+        [0, VIEWS_PER_DISPATCH * 64, VIEWS_PER_DISPATCH * 80]

@@ -25,6 +25,8 @@ from .kernels import wendland
 
 GOLDEN_FRACTION = 0.6180339887498949
 SELF_OFFSET = 1.75  # voxels; > sqrt(3)
+# What the GPU passes that mirror this module get as defines (hao_ao.comp, near_field.comp).
+GLSL_DEFINES = {"HAO_GOLDEN_FRACTION": GOLDEN_FRACTION, "HAO_SELF_OFFSET": SELF_OFFSET}
 
 
 def pcg3d(v: np.ndarray) -> np.ndarray:

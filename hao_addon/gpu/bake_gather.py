@@ -72,6 +72,11 @@ def texel_list_shader(fill: bool) -> "gpu.types.GPUShader":
 # direction per dispatch.
 VIEWS_PER_DISPATCH = 4
 MAX_BATCHED_VIEW_SIDE = 2048
+# The GatherViews uniform block (gpu_shaders/bake_gather_views.glsl, std140): its arrays hold
+# VIEWS_PER_DISPATCH entries (GATHER_MAX_VIEWS in GLSL); mat4 columns and vec4s need no padding.
+GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (VIEWS_PER_DISPATCH, 4, 4)),
+                               ("omega", "<f4", (VIEWS_PER_DISPATCH, 4)),
+                               ("view_info", "<f4", (VIEWS_PER_DISPATCH, 4))])
 # Dispatch only the entries of normal bins that can face a view (False: every entry; the
 # results are the same, tests/test_bake_analytic.py).
 NORMAL_BINNING = True
@@ -86,6 +91,7 @@ def _gather_info(uniform: bool, views: int) -> "gpu.types.GPUShaderCreateInfo":
     info.local_group_size(GROUP_SIZE, 1, 1)
     info.define("LIST_WIDTH", str(LIST_WIDTH))
     info.define("VIEWS", str(views))
+    info.define("GATHER_MAX_VIEWS", str(VIEWS_PER_DISPATCH))
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
     info.push_constant('INT', "first_entry")
@@ -128,10 +134,9 @@ class GatherBaker(LightViewBaker):
         self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
                           for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
-        # GatherViews (gpu_shaders/bake_gather_views.glsl), std140: 4 mat4, 4 vec4, 4 vec4;
-        # one buffer per bake, rewritten before each dispatch.
-        self.views_data = np.zeros(4 * 16 + 4 * 4 + 4 * 4, np.float32)
-        self.views_block = gpu.types.GPUUniformBuf(self.views_data)
+        # GatherViews: one buffer per bake, rewritten before each dispatch.
+        self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
+        self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
         # Batches of nearby directions face nearly the same normal bins (core/normal_bins.py).
         self.direction_order = proximity_order(plan.directions)
         self._build_texel_list()
@@ -270,14 +275,13 @@ class GatherBaker(LightViewBaker):
         views, self.pending = self.pending, []
         if not views or not self.entry_count:
             return
-        block = self.views_data
-        block[:] = 0.0
+        block = self.views_data[0]
+        self.views_data.view(np.float32)[:] = 0.0
         for k, view in enumerate(views):
-            block[16 * k:16 * k + 16] = view.matrix.T.ravel()  # column-major for GLSL
-            block[64 + 4 * k:68 + 4 * k] = (*view.omega, 0.0)
-            block[80 + 4 * k:84 + 4 * k] = (view.width, view.height,
-                                            view.pixel_size / (view.depth_far - view.depth_near), 0.0)
-        self.views_block.update(block)
+            block["view_proj"][k] = view.matrix.T  # column-major for GLSL
+            block["omega"][k] = (*view.omega, 0.0)
+            block["view_info"][k] = (view.width, view.height, view.pixel_size / (view.depth_far - view.depth_near), 0.0)
+        self.views_block.update(self.views_data.view(np.float32))
         shader = gather_shader(self.plan.settings.weighting == "uniform", len(views))
         shader.bind()
         shader.uniform_block("views", self.views_block)

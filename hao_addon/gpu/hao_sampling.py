@@ -5,10 +5,11 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.ao_pattern import GLSL_DEFINES
 from ..core.view_settings import ViewAOSettings
 from . import util
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
-from .shaders import cached_shader, glsl_source
+from .shaders import add_defines, cached_shader, glsl_source
 
 GROUP = 8
 
@@ -28,6 +29,7 @@ def _ao_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(2, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
     info.image(4, 'R32UI', 'UINT_2D', "sampled_count", qualifiers={'READ', 'WRITE'})
+    add_defines(info, GLSL_DEFINES)
     info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "hao_ao.comp"))
     return info
 

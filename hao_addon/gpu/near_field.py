@@ -6,10 +6,11 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.ao_pattern import GLSL_DEFINES
 from ..core.near_field import camera_terms
 from .hao_sampling import GROUP
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
-from .shaders import cached_shader, glsl_source
+from .shaders import add_defines, cached_shader, glsl_source
 
 
 def _near_info() -> "gpu.types.GPUShaderCreateInfo":
@@ -26,6 +27,7 @@ def _near_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(2, 'RGBA32F', 'FLOAT_2D', "back_position", qualifiers={'READ'})
     info.image(3, 'RGBA32F', 'FLOAT_2D', "back_normal", qualifiers={'READ'})
     info.image(4, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
+    add_defines(info, GLSL_DEFINES)
     info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "near_field.comp"))
     return info
 

@@ -39,6 +39,12 @@ def glsl_source(*names: str) -> str:
     return "\n".join(f"/* --- {n} --- */\n{load_glsl(n)}" for n in names)
 
 
+def add_defines(info: "gpu.types.GPUShaderCreateInfo", defines: dict[str, float | int]) -> None:
+    """Python constants into GLSL (``repr`` keeps every digit of a float)."""
+    for name, value in defines.items():
+        info.define(name, repr(float(value)) if isinstance(value, float) else str(int(value)))
+
+
 def compile_with_log(info: "gpu.types.GPUShaderCreateInfo", label: str) -> "gpu.types.GPUShader":
     """``gpu.shader.create_from_info`` that raises ShaderCompileError with the driver log."""
     sys.stdout.flush()
