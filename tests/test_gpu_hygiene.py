@@ -80,13 +80,14 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
 def test_constants_reach_glsl_from_python_only():
     """Each constant the GPU and its numpy mirror share is written once, in Python."""
     from hao_addon.core.ao_pattern import GLSL_DEFINES
-    from hao_addon.gpu.bake_gather import GATHER_VIEWS_DTYPE, VIEWS_PER_DISPATCH
+    from hao_addon.gpu.bake_gather import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE, VIEWS_PER_DISPATCH
     from hao_addon.gpu.shaders import SHADER_DIR
     sources = {p.name: p.read_text() for p in SHADER_DIR.iterdir()}
     for name, value in GLSL_DEFINES.items():
         assert not any(f"#define {name}" in s or repr(value) in s for s in sources.values()), name
     assert "[4]" not in sources["bake_gather_views.glsl"] and "GATHER_MAX_VIEWS" in sources["bake_gather_views.glsl"]
-    # std140 size of GatherViews: VIEWS_PER_DISPATCH mat4 (64 B) and two arrays of vec4 (16 B).
-    assert GATHER_VIEWS_DTYPE.itemsize == VIEWS_PER_DISPATCH * (64 + 16 + 16)
+    # std140 size of GatherViews: GATHER_MAX_VIEWS mat4 (64 B) and two arrays of vec4 (16 B).
+    assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
+    assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16)
     assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "omega", "view_info")] == \
-        [0, VIEWS_PER_DISPATCH * 64, VIEWS_PER_DISPATCH * 80]
+        [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80]

@@ -73,16 +73,19 @@ def texel_list_shader(fill: bool) -> "gpu.types.GPUShader":
 VIEWS_PER_DISPATCH = 4
 MAX_BATCHED_VIEW_SIDE = 2048
 # The GatherViews uniform block (gpu_shaders/bake_gather_views.glsl, std140): its arrays hold
-# VIEWS_PER_DISPATCH entries (GATHER_MAX_VIEWS in GLSL); mat4 columns and vec4s need no padding.
-GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (VIEWS_PER_DISPATCH, 4, 4)),
-                               ("omega", "<f4", (VIEWS_PER_DISPATCH, 4)),
-                               ("view_info", "<f4", (VIEWS_PER_DISPATCH, 4))])
+# GATHER_MAX_VIEWS entries (a GLSL define of the same name), VIEWS_PER_DISPATCH <= that of them
+# used; mat4 columns and vec4s need no padding.
+GATHER_MAX_VIEWS = 4
+GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
+                               ("omega", "<f4", (GATHER_MAX_VIEWS, 4)),
+                               ("view_info", "<f4", (GATHER_MAX_VIEWS, 4))])
 # Dispatch only the entries of normal bins that can face a view (False: every entry; the
 # results are the same, tests/test_bake_analytic.py).
 NORMAL_BINNING = True
 
 
 def views_per_dispatch(plan: BakePlan) -> int:
+    assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
     return VIEWS_PER_DISPATCH if plan.max_view_side <= MAX_BATCHED_VIEW_SIDE else 1
 
 
@@ -91,7 +94,7 @@ def _gather_info(uniform: bool, views: int) -> "gpu.types.GPUShaderCreateInfo":
     info.local_group_size(GROUP_SIZE, 1, 1)
     info.define("LIST_WIDTH", str(LIST_WIDTH))
     info.define("VIEWS", str(views))
-    info.define("GATHER_MAX_VIEWS", str(VIEWS_PER_DISPATCH))
+    info.define("GATHER_MAX_VIEWS", str(GATHER_MAX_VIEWS))
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
     info.push_constant('INT', "first_entry")
