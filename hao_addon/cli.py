@@ -322,7 +322,6 @@ def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
     """(exit code, one-line message) for any exception."""
     import signal
 
-    from .core.unwrap import UnwrapError
     if isinstance(exc, KeyboardInterrupt):
         return EXIT_INTERRUPTED[signal.SIGINT], "interrupted (SIGINT): nothing was written"
     if isinstance(exc, Terminated):
@@ -335,7 +334,7 @@ def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
         GPUUnavailableError = ()  # noqa: N806
     if GPUUnavailableError and isinstance(exc, GPUUnavailableError):
         return EXIT_NO_GPU, _last_line(exc)
-    if isinstance(exc, (BakeInputError, UnwrapError, OSError)):
+    if isinstance(exc, (BakeInputError, OSError)):  # UnwrapError and SettingError included
         return EXIT_BAD_INPUT, _last_line(exc)
     if os.environ.get(DEBUG_ENV):
         io.err.write(io.log() + "".join(traceback.format_exception(exc)))

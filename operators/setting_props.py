@@ -31,7 +31,7 @@ def tooltip(text: str) -> str:
 
 def blender_property(field, spec, update=None):
     """The bpy.props definition of one setting."""
-    kw = {"name": spec.label, "description": tooltip(spec.description), "default": field.default}
+    kw = {"name": spec.label, "description": spec.sentence, "default": field.default}
     if update is not None:
         kw["update"] = update
     if spec.choices:

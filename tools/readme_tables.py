@@ -29,7 +29,7 @@ def table(*settings_classes) -> str:
             option = f"`{spec.option(f.name)}`" if spec.option(f.name) else "(panel only)"
             label = spec.label if spec.ui else "(command line only)"
             default = f"`{f.default}`" if not isinstance(f.default, bool) else ("on" if f.default else "off")
-            what = spec.description[:1].upper() + spec.description[1:]
+            what = spec.sentence
             if spec.choices:
                 what += ": " + "; ".join(f"*{c.label}* (`{c.value}`) {c.description}" for c in spec.choices)
             rows.append(f"| {label} | {option} | {default} | {spec.range_text() or '-'} | {what}. |")

@@ -43,6 +43,11 @@ class Spec:
     ui: bool = True
 
     @property
+    def sentence(self) -> str:
+        """The description as a tooltip or table cell starts: capitalized."""
+        return self.description[:1].upper() + self.description[1:]
+
+    @property
     def message_name(self) -> str:
         return self.noun or self.label.lower()
 
