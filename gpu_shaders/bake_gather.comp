@@ -26,15 +26,31 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
   return (depth - bias <= texelFetch(depth_tex, px, 0).r) ? 1.0 : 0.0;
 }
 
-/* Hemisphere weight of a light at cos_theta > 0 (times 1 / S_f, added in GATHER_VIEW). */
+/* Hemisphere weight of a light at cos_theta > 0 (times 1 / S, added in GATHER_VIEW). */
 #ifdef UNIFORM_WEIGHTING
 #  define VIEW_WEIGHT(cos_theta) 1.0
 #else
 #  define VIEW_WEIGHT(cos_theta) (cos_theta)
 #endif
 
-/* Adds one view's term to sum when the entry faces that light. */
-#define GATHER_VIEW(depth_tex, k) \
+/* Adds one view's term to sum when the entry faces that light. With shading normals the
+ * weight is about the shading normal and visibility is judged from the true surface; a
+ * direction above the shading hemisphere but below the face (the terminator) counts as
+ * occluded, as in Cycles' AO pass, which traces only directions above the geometric normal. */
+#ifdef SHADING_NORMALS
+#  define GATHER_VIEW(depth_tex, k) \
+  { \
+    float cos_theta = dot(normal, views.omega[k].xyz); \
+    if (cos_theta > 0.0) { \
+      float weight = VIEW_WEIGHT(cos_theta) * position.w; \
+      float cos_true = dot(geometric, views.omega[k].xyz); \
+      float visible = (cos_true > 0.0) ? \
+          visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_true) : 0.0; \
+      sum += vec2(weight * visible, weight); \
+    } \
+  }
+#else
+#  define GATHER_VIEW(depth_tex, k) \
   { \
     float cos_theta = dot(normal, views.omega[k].xyz); \
     if (cos_theta > 0.0) { \
@@ -42,6 +58,7 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
       sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
     } \
   }
+#endif
 
 void main()
 {
@@ -52,8 +69,14 @@ void main()
     return;
   }
   ivec2 slot = ivec2(index % LIST_WIDTH, index / LIST_WIDTH);
-  vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = 1 / S_f */
+  vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = 1 / S */
+#ifdef SHADING_NORMALS
+  vec4 normals = imageLoad(entry_normal, slot);
+  vec3 normal = octahedral_decode(normals.xy);
+  vec3 geometric = octahedral_decode(normals.zw);
+#else
   vec3 normal = imageLoad(entry_normal, slot).xyz;
+#endif
   vec2 sum = imageLoad(accum, slot).xy;
   vec2 before = sum;
   GATHER_VIEW(depth_tex0, 0)

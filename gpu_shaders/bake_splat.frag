@@ -11,7 +11,14 @@
  * one point per pixel with additive blending; fragment image atomics do the same scatter.) */
 void main()
 {
-  float cos_theta = dot(face_data.xyz, omega.xyz);
+#ifdef SHADING_NORMALS
+  /* The interpolated shading normal; the weight is about it, visibility from the true
+   * (flat) surface this fragment lies on. */
+  vec3 normal = normalize(face_data.xyz);
+#else
+  vec3 normal = face_data.xyz;
+#endif
+  float cos_theta = dot(normal, omega.xyz);
   if (face_data.w <= 0.0 || cos_theta <= 0.0) {
     discard;
   }
@@ -55,6 +62,16 @@ void main()
   float nearest = texelFetch(depth_tex, ivec2(gl_FragCoord.xy), 0).r;
   float visible = (gl_FragCoord.z <= nearest + depth_tolerance) ? 1.0 : 0.0;
 #endif
+#ifdef SHADING_NORMALS
+  /* The terminator: directions above the shading hemisphere but below the face count as
+   * occluded (Cycles' AO pass traces only directions above the geometric normal). Averted
+   * faces are not drawn; the denominator here sums the directions above the face, whose
+   * weights total above_fraction of S, so the numerator carries that fraction: the ratio is
+   * the whole estimator (core/plan.py, _shading_corners). */
+  float weight_den = weight / max(above_fraction, 1e-6);
+#else
+  float weight_den = weight;
+#endif
   /* Footprint-aware splat: where this pixel's UV footprint (the parallelogram spanned by
    * dx and dy) is wider than a texel, spread the weight over an nx x ny grid of points inside
    * it, so no texel under the footprint is skipped (without this, UV regions denser than the
@@ -63,7 +80,7 @@ void main()
 #if MAX_FOOTPRINT == 1
   /* The plan found no UV region much denser than the light view: a single splat, and no
    * loop (llvmpipe runs this shader about 35 % slower when the loop is merely present). */
-  splat_bilinear(uv_texel, weight * visible, weight);
+  splat_bilinear(uv_texel, weight * visible, weight_den);
 #else
   int nx = clamp(int(ceil(length(dx) / 1.5)), 1, MAX_FOOTPRINT);
   int ny = clamp(int(ceil(length(dy) / 1.5)), 1, MAX_FOOTPRINT);
@@ -71,7 +88,7 @@ void main()
   for (int j = 0; j < ny; j++) {
     for (int i = 0; i < nx; i++) {
       vec2 p = uv_texel + ((float(i) + 0.5) / float(nx) - 0.5) * dx + ((float(j) + 0.5) / float(ny) - 0.5) * dy;
-      splat_bilinear(p, weight * visible * share, weight * share);
+      splat_bilinear(p, weight * visible * share, weight_den * share);
     }
   }
 #endif

@@ -20,7 +20,13 @@ void main()
   }
   ivec2 slot = ivec2(int(index % uint(LIST_WIDTH)), int(index / uint(LIST_WIDTH)));
   imageStore(entry_position, slot, vec4(world_pos, face_data.w));
+#  ifdef SHADING_NORMALS
+  /* Both normals: the weight is about the shading one, visibility and its bias belong to the
+   * true surface. */
+  imageStore(entry_normal, slot, vec4(octahedral_encode(normalize(face_data.xyz)), octahedral_encode(geometric_normal)));
+#  else
   imageStore(entry_normal, slot, vec4(face_data.xyz, 0.0));
+#  endif
   imageStore(entry_texel, slot, uvec4((uint(gl_FragCoord.y) << 16) | uint(gl_FragCoord.x)));
 #endif
 }

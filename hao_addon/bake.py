@@ -45,6 +45,7 @@ def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeS
         h.update(b"|uv|" if soup.uvs is not None else b"|no-uv|")
         if soup.uvs is not None:
             h.update(np.ascontiguousarray(soup.uvs).tobytes())
+        h.update(b"|flat|" if soup.normals is None else np.ascontiguousarray(soup.normals).tobytes())
     return h.hexdigest()
 
 
@@ -68,7 +69,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True})
 
     plan = make_plan(target, occluders, settings)
-    from .gpu import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
+    from .bakers import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
     baker_cls = baker_for(settings.resolved_method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)

@@ -190,7 +190,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         out = output_path_for(request, obj)
         report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
                                    uv_map_created=any(n == uv_name for _m, n in job.created_uv),
-                                   covered_texels=st["covered_texels"], method=st["method"]))
+                                   covered_texels=st["covered_texels"], method=st["method"],
+                                   smooth_corners=st["smooth_corners"]))
         report.outputs.append(out)
         report.warnings.extend(st.get("warnings", []))
         lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "

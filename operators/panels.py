@@ -29,6 +29,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.active = settings.max_distance > 0.0
         sub.prop(settings, "falloff")
         col.prop(settings, "weighting")
+        col.prop(settings, "normals")
         col.prop(settings, "ignore_back_faces")
         col.prop(settings, "occluders")
         col.separator()

@@ -68,7 +68,8 @@ def test_object_token_and_json_report(dirs):
     assert data["status"] == "ok" and data["exit_code"] == 0 and data["error"] is None
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
-                                    covered_texels=data["objects"][0]["covered_texels"], method="gather")]
+                                    covered_texels=data["objects"][0]["covered_texels"], method="gather",
+                                    smooth_corners=0)]  # spot.obj has no 's' groups: flat
     assert data["settings"]["size"] == 64 and data["settings"]["view_samples"] == 2.0
     assert {"load", "bake", "write", "total", "unwrap"} <= set(data["timings"])
     assert any("outside the 0..1 UV tile" in w for w in data["warnings"])  # Spot's UVs reach past 0
@@ -78,6 +79,29 @@ def test_object_token_and_json_report(dirs):
     assert proc.returncode == 2 and data["status"] == "error" and "map size" in data["error"]
     assert data["exit_code"] == 2 and data["outputs"] == [] and not (out / "x.png").exists()
     assert "bake" not in data["timings"] and "load" not in data["timings"]  # refused before any work
+
+
+def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
+    """An OBJ's 's' groups and 'vn' normals reach the bake through Blender's importer (the
+    evaluated mesh's corner normals); --normals face bakes flat anyway."""
+    out, tmp = dirs
+    smooth = tmp.parent / "spot_smooth.obj"
+    lines = SPOT.read_text().splitlines(keepends=True)
+    first_face = next(i for i, line in enumerate(lines) if line.startswith("f "))
+    smooth.write_text("".join(lines[:first_face] + ["s 1\n"] + lines[first_face:]))
+    suzanne = ROOT / "tests" / "data" / "suzanne.obj"  # one 'vn' per vertex, no UVs: xatlas unwraps it
+
+    def corners(path, *extra):
+        report = out / "r.json"
+        proc = run(["bake", path, "--size", "64", "--directions", "8", "--out", out / "{object}.png",
+                    "--json", report, "--quiet", *extra], tmp)
+        assert proc.returncode == 0, proc.stderr
+        return json.loads(report.read_text())["objects"][0]["smooth_corners"]
+
+    total = 3 * 5856
+    assert corners(smooth) > 0.9 * total  # smooth: nearly every corner leans off its face
+    assert corners(smooth, "--normals", "face") == 0
+    assert corners(suzanne) > 0
 
 
 def test_output_checks_come_before_any_work(dirs):

@@ -72,7 +72,7 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
 
     from hao_addon.core.plan import make_plan
     from hao_addon.core.seams import finalize_map
-    from hao_addon.gpu import baker_for
+    from hao_addon.bakers import baker_for
 
     torus = scenes.torus(1.0, 0.45, (0, 0, 0), 48, 24)
     tilted = TriangleSoup(torus.positions @ np.array([[1, 0, 0], [0, 0.8, 0.6], [0, -0.6, 0.8]]), torus.uvs)
@@ -110,7 +110,7 @@ def test_gather_draws_averted_faces_only_where_the_light_looks_into_a_hole(gpu_c
 
     from hao_addon.core.plan import make_plan
     from hao_addon.core.seams import finalize_map
-    from hao_addon.gpu import baker_for
+    from hao_addon.bakers import baker_for
 
     sphere = scenes.uv_sphere(0.5, (0.0, 0.0, 0.0), 64, 32)
     segments, sides = 96, 48

@@ -165,8 +165,10 @@ class BakeJob:
         depsgraph = self._depsgraph_getter()
         n = len(req.targets)
         for k, obj in enumerate(req.targets):
-            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name])
-            occluders = [mesh_data.evaluated_soup(o, depsgraph, None) for o in self._occluder_objects(obj)]
+            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name],
+                                              shading_normals=req.settings.normals == "mesh")
+            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
+                         for o in self._occluder_objects(obj)]
             gen = bake_steps(target, occluders, req.settings)
             try:
                 while True:

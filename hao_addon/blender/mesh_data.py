@@ -39,16 +39,37 @@ def loop_uvs(mesh: bpy.types.Mesh, name: str) -> np.ndarray:
     return uv.reshape(-1, 2)
 
 
-def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None) -> TriangleSoup:
-    """The object's evaluated mesh in world space, with the named UV map (or none)."""
+def corner_normals(mesh: bpy.types.Mesh) -> np.ndarray:
+    """(L, 3) float64 shading normal of every corner (loop) as Blender shades the mesh: face
+    normals on flat faces, interpolated on smooth ones, with sharp edges, custom normals and
+    Smooth by Angle applied (Mesh.corner_normals, Blender 4.1+)."""
+    normals = np.empty(len(mesh.loops) * 3, np.float32)
+    mesh.corner_normals.foreach_get("vector", normals)
+    return normals.reshape(-1, 3).astype(np.float64)
+
+
+def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None,
+                   shading_normals: bool = True) -> TriangleSoup:
+    """The object's evaluated mesh in world space, with the named UV map (or none) and, when
+    asked, the corner shading normals. A mirroring transform (negative determinant) turns
+    the triangles inside out; their corners are reordered so faces keep pointing outwards,
+    as Blender and Cycles treat mirrored objects."""
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
         co, tri_verts, tri_loops = _mesh_arrays(mesh)
         m = np.array(obj_eval.matrix_world, dtype=np.float64)
-        world = co @ m[:3, :3].T + m[:3, 3]
+        linear = m[:3, :3]
+        if np.linalg.det(linear) < 0.0:
+            tri_verts, tri_loops = tri_verts[:, ::-1], tri_loops[:, ::-1]
+        world = co @ linear.T + m[:3, 3]
         uvs = loop_uvs(mesh, uv_name)[tri_loops] if uv_name else None
-        return TriangleSoup(world[tri_verts], uvs, name=obj.name)
+        normals = None
+        if shading_normals and len(mesh.loops):
+            # Normals transform with the inverse transpose (non-uniform scale bends them).
+            normal_matrix = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-300 else linear
+            normals = corner_normals(mesh)[tri_loops] @ normal_matrix.T
+        return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals)
     finally:
         obj_eval.to_mesh_clear()
 

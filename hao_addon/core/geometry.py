@@ -14,11 +14,14 @@ class TriangleSoup:
     positions: (F, 3, 3) float64 world-space corners.
     uvs: (F, 3, 2) float64 UV corners in [0, 1] (targets only; None for pure occluders).
     name: label for messages.
+    normals: (F, 3, 3) float64 shading normals at the corners, as the mesh is shaded (smooth,
+    sharp edges, custom normals), world space; None: flat (the face normals).
     """
 
     positions: np.ndarray
     uvs: np.ndarray | None = None
     name: str = "mesh"
+    normals: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=np.float64).reshape(-1, 3, 3)
@@ -26,6 +29,10 @@ class TriangleSoup:
             self.uvs = np.asarray(self.uvs, dtype=np.float64).reshape(-1, 3, 2)
             if len(self.uvs) != len(self.positions):
                 raise ValueError(f"{self.name}: {len(self.uvs)} UV triangles for {len(self.positions)} triangles")
+        if self.normals is not None:
+            self.normals = np.asarray(self.normals, dtype=np.float64).reshape(-1, 3, 3)
+            if len(self.normals) != len(self.positions):
+                raise ValueError(f"{self.name}: {len(self.normals)} normal triangles for {len(self.positions)} triangles")
 
     @property
     def face_count(self) -> int:
@@ -52,6 +59,46 @@ def face_normals_areas(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     normals = np.zeros_like(cross)
     normals[valid] = cross[valid] / length[valid, None]
     return normals, np.where(valid, 0.5 * length, 0.0)
+
+
+def corner_shading_normals(positions: np.ndarray, normals: np.ndarray | None,
+                           face_normals: np.ndarray) -> tuple[np.ndarray, int]:
+    """Unit shading normals (F, 3, 3) of (F, 3, 3) triangles from the corner normals a mesh
+    carries (or None: flat), and how many corners differ from their face's normal.
+
+    A corner normal that is zero, not finite, or on a zero-area face falls back to the face
+    normal (Blender writes such normals for degenerate faces; a NaN must not reach a shader).
+    """
+    flat = np.repeat(np.asarray(face_normals, np.float64)[:, None, :], 3, axis=1)
+    if normals is None:
+        return flat, 0
+    n = np.asarray(normals, np.float64).reshape(-1, 3, 3)
+    length = np.sqrt(np.einsum("fki,fki->fk", n, n))
+    good = np.isfinite(length) & (length > 1e-12) & (np.abs(face_normals).sum(axis=1) > 0.0)[:, None]
+    unit = np.where(good[..., None], n / np.where(good, length, 1.0)[..., None], flat)
+    # float32 shaders cannot tell apart normals this close: such a corner is flat.
+    differs = np.einsum("fki,fki->fk", unit, flat) < 1.0 - 1e-6
+    return unit, int(differs.sum())
+
+
+def smooth_vertex_normals(positions: np.ndarray) -> np.ndarray:
+    """(F, 3, 3) corner normals of (F, 3, 3) triangles shaded smooth the way Blender does it:
+    at each welded vertex the face normals weighted by the corner angle, normalized."""
+    verts, tri = _welded_triangles(positions)
+    p = verts[tri]  # (F, 3, 3)
+    face_n, _ = face_normals_areas(p)
+    angle = np.empty(tri.shape)
+    for k in range(3):
+        e1 = p[:, (k + 1) % 3] - p[:, k]
+        e2 = p[:, (k + 2) % 3] - p[:, k]
+        cos = np.einsum("fi,fi->f", e1, e2) / np.maximum(
+            np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1), 1e-300)
+        angle[:, k] = np.arccos(np.clip(cos, -1.0, 1.0))
+    sums = np.zeros((len(verts), 3))
+    np.add.at(sums, tri.ravel(), (face_n[:, None, :] * angle[..., None]).reshape(-1, 3))
+    length = np.linalg.norm(sums, axis=1, keepdims=True)
+    vertex_n = np.divide(sums, length, out=np.zeros_like(sums), where=length > 1e-300)
+    return vertex_n[tri]
 
 
 def uv_areas(uvs: np.ndarray) -> np.ndarray:

@@ -54,3 +54,30 @@ def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str
             block = (block > 0.0).astype(np.float32)
         out[start:start + chunk] = block @ ones  # BLAS row sums
     return out
+
+
+def corner_normalizers(shading: np.ndarray, face_normals: np.ndarray, directions: np.ndarray,
+                       weighting: str = "cosine", chunk: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+    """S and its above-face part at every corner of shaded faces.
+
+    shading: (F, 3, 3) unit corner shading normals; face_normals: (F, 3) unit face normals;
+    directions: (D, 3). Returns (S (F, 3), S_above (F, 3)) float64: sum_d weight(w_d . n_s),
+    and the same over the directions with w_d . n_f > 0 (those the true surface can see).
+    float32 products as in face_normalizers.
+    """
+    if weighting not in WEIGHTINGS:
+        raise ValueError(f"unknown weighting '{weighting}', expected one of {WEIGHTINGS}")
+    dirs_t = np.ascontiguousarray(np.asarray(directions, dtype=np.float32).T)
+    ones = np.ones(dirs_t.shape[1], np.float32)
+    shading = np.asarray(shading, np.float32)
+    faces = np.asarray(face_normals, np.float32)
+    total = np.empty((len(faces), 3))
+    above = np.empty((len(faces), 3))
+    for start in range(0, len(faces), chunk):
+        up = (faces[start:start + chunk] @ dirs_t) > 0.0  # (chunk, D)
+        for k in range(3):
+            block = shading[start:start + chunk, k] @ dirs_t
+            block = np.maximum(block, 0.0) if weighting == "cosine" else (block > 0.0).astype(np.float32)
+            total[start:start + chunk, k] = block @ ones
+            above[start:start + chunk, k] = np.where(up, block, 0.0) @ ones
+    return total, above

@@ -40,17 +40,47 @@ def uniform_hemisphere(count: int, rng: np.random.Generator) -> np.ndarray:
     return np.stack([r * np.cos(2 * np.pi * v), r * np.sin(2 * np.pi * v), z], axis=1)
 
 
+def first_hit(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
+              face_normals: np.ndarray | None) -> float:
+    """Distance along `direction` (3,) from `origin` to the first hit within `reach` (inf if
+    none); faces whose normal points along the ray (seen from behind) are skipped when
+    face_normals (F, 3) is given (back faces ignored)."""
+    dv = Vector(direction)
+    o = origin
+    travelled = 0.0
+    for _ in range(32):  # back-face skips
+        loc, _n, idx, dist = ray_cast(o, dv, reach - travelled)
+        if loc is None:
+            return np.inf
+        travelled += dist
+        if face_normals is not None and float(face_normals[idx] @ direction) > 0.0:
+            o = loc + dv * offset  # a back face: skip it and continue
+            continue
+        return travelled
+    return np.inf
+
+
+def ray_offset(point: np.ndarray, scene_radius: float) -> float:
+    """How far a ray starts off the surface at `point` (3,): see the module docstring."""
+    return 1e-6 * scene_radius + 1e-7 * float(np.abs(point).max())
+
+
 def reference_accessibility(points: np.ndarray, normals: np.ndarray, triangles: np.ndarray,
                             rays: int = 1024, max_distance: float = 0.0, falloff: str = "none",
                             weighting: str = "cosine", ignore_back_faces: bool = False,
-                            seed: int = 0, bvh: BVHTree | None = None) -> np.ndarray:
+                            seed: int = 0, bvh: BVHTree | None = None,
+                            geometric_normals: np.ndarray | None = None) -> np.ndarray:
     """Accessibility at surface points.
 
-    points, normals: (n, 3); triangles: (F, 3, 3) the whole occluding scene (the receivers
-    included). Returns (n,) float64 in [0, 1].
+    points, normals: (n, 3), normals the shading normals the hemisphere is about;
+    triangles: (F, 3, 3) the whole occluding scene (the receivers included).
+    geometric_normals: (n, 3) the true surface's normals where they differ (None: the same):
+    rays start off that surface, and directions below it count as occluded (Cycles' AO pass
+    traces only directions above the geometric normal). Returns (n,) float64 in [0, 1].
     """
     points = np.asarray(points, dtype=np.float64)
     normals = np.asarray(normals, dtype=np.float64)
+    true_normals = normals if geometric_normals is None else np.asarray(geometric_normals, np.float64)
     bvh = bvh or build_bvh(triangles)
     flat = triangles.reshape(-1, 3)
     radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
@@ -63,22 +93,11 @@ def reference_accessibility(points: np.ndarray, normals: np.ndarray, triangles: 
     for i in range(len(points)):
         local = stratified_cosine_hemisphere(rays, rng) if weighting == "cosine" else uniform_hemisphere(rays, rng)
         world = local @ frames[i]
-        offset = 1e-6 * radius + 1e-7 * float(np.abs(points[i]).max())
-        origin = Vector(points[i] + normals[i] * offset)
-        dists = np.full(len(world), np.inf)
-        for k, d in enumerate(world):
-            dv = Vector(d)
-            o = origin
-            travelled = 0.0
-            for _ in range(32):  # back-face skips
-                loc, _n, idx, dist = ray_cast(o, dv, reach - travelled)
-                if loc is None:
-                    break
-                travelled += dist
-                if face_n is not None and float(face_n[idx] @ d) > 0.0:
-                    o = loc + dv * offset  # a back face: skip it and continue
-                    continue
-                dists[k] = travelled
-                break
+        offset = ray_offset(points[i], radius)
+        origin = Vector(points[i] + true_normals[i] * offset)
+        above = world @ true_normals[i] > 0.0
+        dists = np.zeros(len(world))  # below the true surface: occluded at once
+        for k in np.flatnonzero(above):
+            dists[k] = first_hit(ray_cast, origin, world[k], reach, offset, face_n)
         out[i] = 1.0 - occlusion_weight(dists, max_distance, falloff).mean()
     return out

@@ -22,12 +22,19 @@ WEIGHTING_CHOICES = (
     Choice("cosine", "Cosine", "Lambertian ambient occlusion (what Cycles bakes)"),
     Choice("uniform", "Uniform", "fraction of the open hemisphere"),
 )
+NORMALS_CHOICES = (
+    Choice("mesh", "Mesh Shading", "the mesh's own shading as Blender evaluates it: smooth faces interpolated, "
+                                   "sharp edges and custom normals kept (what Cycles bakes)"),
+    Choice("face", "Face", "flat: every texel uses its triangle's normal"),
+)
 METHOD_CHOICES = (
     Choice("auto", "Auto", "the gather for unlimited distance (fastest at equal error in the benchmark), "
                            "the scatter with a max distance"),
     Choice("scatter", "Histogram Scatter", "McGraw & Sowers: texel-area average; supports max distance and falloff"),
     Choice("gather", "Shadow-Map Gather", "shadow maps sampled at texel centres (the paper's baseline); "
                                           "unlimited distance only"),
+    Choice("reference", "Reference (CPU)", "the same estimator ray traced on the CPU: slow (minutes), "
+                                           "for checking a GPU bake"),
 )
 METHODS = tuple(c.value for c in METHOD_CHOICES)
 
@@ -50,6 +57,9 @@ class BakeSettings:
         description="how occlusion fades with distance (only with a max distance)")
     weighting: str = setting(
         "cosine", label="Weighting", choices=WEIGHTING_CHOICES, description="how directions over the hemisphere count")
+    normals: str = setting(
+        "mesh", label="Normals", choices=NORMALS_CHOICES,
+        description="which normal the hemisphere is about; visibility is always tested from the true surface")
     ignore_back_faces: bool = setting(
         False, label="Ignore Back Faces", description="faces seen from behind do not occlude (open or single-sided meshes)")
     margin: int = setting(

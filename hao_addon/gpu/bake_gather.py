@@ -36,16 +36,20 @@ GROUP_SIZE = 64
 ENTRY_BYTES = 16 + 16 + 4 + 8  # position + 1/S_f, normal, texel, (numerator, denominator)
 
 
-def _texel_list_info(fill: bool) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}")
+def _texel_list_info(fill: bool, shading: bool) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}{int(shading)}")
     iface.smooth('VEC3', "world_pos")
-    iface.flat('VEC4', "face_data")
+    iface.smooth('VEC4', "face_data")
+    iface.flat('VEC3', "geometric_normal")
     iface.flat('INT', "face_bin")
     info = gpu.types.GPUShaderCreateInfo()
     info.vertex_in(0, 'VEC3', "pos")
     info.vertex_in(1, 'VEC2', "uv")
     info.vertex_in(2, 'VEC4', "face")
     info.vertex_in(3, 'FLOAT', "bin")
+    info.vertex_in(4, 'VEC3', "geometric")
+    if shading:
+        info.define("SHADING_NORMALS", "1")
     info.vertex_out(iface)
     info.fragment_out(0, 'VEC4', "list_out")
     info.image(0, 'R32UI', 'UINT_2D', "bin_count", qualifiers={'READ', 'WRITE'})
@@ -58,12 +62,13 @@ def _texel_list_info(fill: bool) -> "gpu.types.GPUShaderCreateInfo":
         info.image(3, 'R32UI', 'UINT_2D', "entry_texel", qualifiers={'WRITE'})
         info.image(4, 'R32F', 'FLOAT_2D', "bin_start", qualifiers={'READ'})
     info.vertex_source(glsl_source("bake_texel_list.vert"))
-    info.fragment_source(glsl_source("bake_texel_list.frag"))
+    info.fragment_source(glsl_source("octahedral.glsl", "bake_texel_list.frag"))
     return info
 
 
-def texel_list_shader(fill: bool) -> "gpu.types.GPUShader":
-    return cached_shader(("bake_texel_list", fill), lambda: _texel_list_info(fill))
+def texel_list_shader(fill: bool, shading: bool = False) -> "gpu.types.GPUShader":
+    """shading: entries carry the shading and the face normal (plan.smooth_shading)."""
+    return cached_shader(("bake_texel_list", fill, shading), lambda: _texel_list_info(fill, shading))
 
 
 # Directions tested per compute dispatch: an entry and its sums are loaded once for all of
@@ -89,8 +94,10 @@ def views_per_dispatch(plan: BakePlan) -> int:
     return VIEWS_PER_DISPATCH if plan.max_view_side <= MAX_BATCHED_VIEW_SIDE else 1
 
 
-def _gather_info(uniform: bool, views: int) -> "gpu.types.GPUShaderCreateInfo":
+def _gather_info(uniform: bool, views: int, shading: bool) -> "gpu.types.GPUShaderCreateInfo":
     info = gpu.types.GPUShaderCreateInfo()
+    if shading:
+        info.define("SHADING_NORMALS", "1")
     info.local_group_size(GROUP_SIZE, 1, 1)
     info.define("LIST_WIDTH", str(LIST_WIDTH))
     info.define("VIEWS", str(views))
@@ -106,13 +113,14 @@ def _gather_info(uniform: bool, views: int) -> "gpu.types.GPUShaderCreateInfo":
     info.image(0, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'READ'})
     info.image(2, 'RG32F', 'FLOAT_2D', "accum", qualifiers={'READ', 'WRITE'})
-    info.compute_source(glsl_source("bake_gather.comp"))
+    info.compute_source(glsl_source("octahedral.glsl", "bake_gather.comp"))
     return info
 
 
-def gather_shader(uniform: bool, views: int = 1) -> "gpu.types.GPUShader":
-    """The texel test of `views` (1 to VIEWS_PER_DISPATCH) directions per dispatch."""
-    return cached_shader(("bake_gather", uniform, views), lambda: _gather_info(uniform, views))
+def gather_shader(uniform: bool, views: int = 1, shading: bool = False) -> "gpu.types.GPUShader":
+    """The texel test of `views` (1 to VIEWS_PER_DISPATCH) directions per dispatch; shading:
+    entries carry shading normals (plan.smooth_shading)."""
+    return cached_shader(("bake_gather", uniform, views, shading), lambda: _gather_info(uniform, views, shading))
 
 
 class GatherBaker(LightViewBaker):
@@ -145,7 +153,8 @@ class GatherBaker(LightViewBaker):
         self._build_texel_list()
         self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
-                          views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0)
+                          views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0,
+                          shading_normals=self.plan.smooth_shading)
 
     def _draw_order(self) -> np.ndarray | None:
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
@@ -162,7 +171,11 @@ class GatherBaker(LightViewBaker):
         """The target with each face's normal bin, and the cones of the bins' normals."""
         faces = self.plan.target_faces
         bins = normal_bins(faces[:, :3])
-        self.bin_axis, self.bin_threshold = bin_cones(faces[:, :3], bins, faces[:, 3] > 0.0)
+        # An entry weighs in wherever its shading normal faces the light: each bin's cone
+        # holds its corners' shading normals (and so every normal interpolated between them).
+        corners = self.plan.target_corners
+        self.bin_axis, self.bin_threshold = bin_cones(corners[..., :3].reshape(-1, 3), np.repeat(bins, 3),
+                                                      np.repeat(faces[:, 3] > 0.0, 3))
         return plan_batch(self.plan, with_occluders=False, face_bins=bins)
 
     def _views_fitted(self, indices: list[int], views: list) -> None:
@@ -196,8 +209,8 @@ class GatherBaker(LightViewBaker):
                 self.target_batch.draw(shader)
             util.image_barrier()
 
-        fill = texel_list_shader(True)
-        draw(texel_list_shader(False))
+        fill = texel_list_shader(True, self.plan.smooth_shading)
+        draw(texel_list_shader(False, self.plan.smooth_shading))
         per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
         count = int(per_bin.sum())
         self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
@@ -285,7 +298,7 @@ class GatherBaker(LightViewBaker):
             block["omega"][k] = (*view.omega, 0.0)
             block["view_info"][k] = (view.width, view.height, view.pixel_size / (view.depth_far - view.depth_near), 0.0)
         self.views_block.update(self.views_data.view(np.float32))
-        shader = gather_shader(self.plan.settings.weighting == "uniform", len(views))
+        shader = gather_shader(self.plan.settings.weighting == "uniform", len(views), self.plan.smooth_shading)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         for k in range(len(views)):

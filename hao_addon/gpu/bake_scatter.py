@@ -53,8 +53,11 @@ def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
-def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShaderCreateInfo":
+def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
+                shading: bool) -> "gpu.types.GPUShaderCreateInfo":
     info = soup_shader_info("bake_splat", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
+    if shading:
+        info.define("SHADING_NORMALS", "1")
     info.image(0, 'R32UI', 'UINT_2D', "accum", qualifiers={'READ', 'WRITE'})
     info.push_constant('FLOAT', "fixed_scale")
     info.push_constant('FLOAT', "depth_tolerance")
@@ -80,9 +83,11 @@ def layers_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_layers", LAYERS), _layers_info)
 
 
-def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool) -> "gpu.types.GPUShader":
-    key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT)
-    return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint))
+def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
+                 shading: bool = False) -> "gpu.types.GPUShader":
+    """shading: weight by interpolated shading normals, with the terminator rule (plan.smooth_shading)."""
+    key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT, shading)
+    return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint, shading))
 
 
 class ScatterBaker(LightViewBaker):
@@ -120,14 +125,16 @@ class ScatterBaker(LightViewBaker):
             self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
             self.layer_count = self.layer_depth = self.overflow = None
         self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
-                                       settings.falloff == "wendland", plan.needs_footprint_splat)
+                                       settings.falloff == "wendland", plan.needs_footprint_splat,
+                                       plan.smooth_shading)
         self.chunk = min(CHUNK_DIRECTIONS, settings.directions)
         self.fixed_scale = float(CHUNK_TARGET * settings.directions / (4.0 * self.chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
         self.den = np.zeros((size, size), dtype=np.float64)
         self.pending = 0
         self.stats = dict(view_pixels=0, directions_done=0, layered=self.layered, layer_overflow_pixels=0,
-                          footprint_splat=plan.needs_footprint_splat, max_chunk_fill=0.0)
+                          footprint_splat=plan.needs_footprint_splat, shading_normals=plan.smooth_shading,
+                          max_chunk_fill=0.0)
 
     def _release(self) -> None:
         self.accum = self.depth = self.dummy = None
@@ -162,8 +169,9 @@ class ScatterBaker(LightViewBaker):
             else:
                 depth_prepass(self.depth_fb, self.all_batch, view, prepass_culling)
             with self.splat_fb.bind():
-                # Target faces turned away from the light add nothing (cos <= 0): cull them
-                # instead of rasterizing and discarding. Front = counter-clockwise = facing it.
+                # Target faces turned away from the light add nothing (cos <= 0, or with shading
+                # normals a terminator direction, carried by above_fraction: bake_splat.frag):
+                # cull them instead of rasterizing and discarding. Front = counter-clockwise = facing it.
                 util.set_overlay_pass_state(w, h, 'BACK')
                 shader = self.splat_prog
                 bind_light_view(shader, view, plan.settings.size)

@@ -24,6 +24,7 @@ def soup_shader_info(name: str, vertex_file: str, varyings: tuple[tuple[str, str
     info.vertex_in(0, 'VEC3', "pos")
     info.vertex_in(1, 'VEC2', "uv")
     info.vertex_in(2, 'VEC4', "face")
+    info.vertex_in(3, 'FLOAT', "above")
     info.vertex_out(iface)
     info.push_constant('MAT4', "view_proj")
     info.push_constant('VEC4', "omega")
@@ -33,7 +34,10 @@ def soup_shader_info(name: str, vertex_file: str, varyings: tuple[tuple[str, str
     return info
 
 
-RASTER_VARYINGS = (('smooth', 'VEC2', "uv_texel"), ('flat', 'VEC4', "face_data"))
+# face_data: the shading normal (not unit length between corners) and 1 / S, interpolated;
+# above_fraction: plan.target_above, interpolated.
+RASTER_VARYINGS = (('smooth', 'VEC2', "uv_texel"), ('smooth', 'VEC4', "face_data"),
+                   ('smooth', 'FLOAT', "above_fraction"))
 
 
 def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
@@ -48,23 +52,28 @@ def depth_shader() -> "gpu.types.GPUShader":
 
 def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None,
                face_bins: np.ndarray | None = None) -> "gpu.types.GPUBatch":
-    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0);
+    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0).
+    Attributes "face" and "above" are per corner: the shading normal and 1 / S
+    (plan.target_corners) and the above-face fraction (plan.target_above).
     order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
-    face normal bins, added as the float attribute "bin" (target alone only)."""
+    face normal bins, added as the float attribute "bin" with the face normal as
+    "geometric" (target alone only)."""
     ft = len(plan.target_positions)
     fo = len(plan.occluder_positions) if with_occluders else 0
     pos = np.concatenate([plan.target_positions, plan.occluder_positions[:fo]])
     uv = np.concatenate([plan.target_uvs, np.zeros((fo, 3, 2), np.float32)])
     occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
-    face = np.concatenate([plan.target_faces, occ_face])
+    face = np.concatenate([plan.target_corners, np.repeat(occ_face[:, None, :], 3, axis=1)])
+    above = np.concatenate([plan.target_above, np.zeros((fo, 3), np.float32)])
     assert len(pos) == ft + fo
     if order is not None:
-        pos, uv, face = pos[order], uv[order], face[order]
+        pos, uv, face, above = pos[order], uv[order], face[order], above[order]
     attrs = {"pos": ('F32', pos.reshape(-1, 3)), "uv": ('F32', uv.reshape(-1, 2)),
-             "face": ('F32', np.repeat(face, 3, axis=0))}
+             "face": ('F32', face.reshape(-1, 4)), "above": ('F32', above.reshape(-1))}
     if face_bins is not None:
         assert fo == 0 and order is None
         attrs["bin"] = ('F32', np.repeat(np.asarray(face_bins, np.float32), 3))
+        attrs["geometric"] = ('F32', np.repeat(plan.target_faces[:, :3], 3, axis=0))
     return util.make_batch('TRIS', attrs)
 
 

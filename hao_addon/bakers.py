@@ -1,0 +1,24 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The one factory of bake passes: a method name -> its baker class. Every baker takes a
+BakePlan and offers check_limits(plan), run_direction(i), accumulated() -> (numerator,
+denominator), stats and free(); the tests run each on the same scenes."""
+from __future__ import annotations
+
+BAKE_METHODS = ("scatter", "gather", "reference")
+
+
+def baker_for(method: str):
+    """The bake pass class for 'scatter', 'gather' (GPU) or 'reference' (CPU ray tracing)."""
+    if method == "reference":
+        import bpy  # noqa: F401 - the bpy module makes mathutils (the reference's BVH) importable
+        from .core.reference_baker import ReferenceBaker
+        return ReferenceBaker
+    if method not in BAKE_METHODS:
+        raise ValueError(f"unknown bake method '{method}', expected one of {BAKE_METHODS}")
+    from .gpu.context import ensure_gpu_context
+    ensure_gpu_context()  # importing the GPU passes needs a GPU context
+    if method == "scatter":
+        from .gpu.bake_scatter import ScatterBaker
+        return ScatterBaker
+    from .gpu.bake_gather import GatherBaker
+    return GatherBaker

@@ -1,0 +1,110 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The bakers' CPU twin: the same estimator as the GPU passes, with visibility ray traced
+(mathutils' BVH) instead of read from depth maps.
+
+Same interface as ScatterBaker and GatherBaker (check_limits, construction from a plan,
+run_direction, accumulated, stats, free) and behind the same factory (hao_addon.bakers), so
+every bake test runs it on the scenes the GPU passes bake. Receivers are the texel centres
+of the target's UV layout (as the gather's); per direction each adds (V w, w) with
+w = weight(omega . n_s) / S interpolated like the GPU passes interpolate them, and V the
+visibility: 0 below the true surface (the terminator rule of Cycles' AO pass), else one ray
+towards the light with the plan's max distance, falloff and back-face rule. Slow (a Python
+call per ray): for tests and for checking a GPU bake, never a silent substitute for one.
+"""
+from __future__ import annotations
+
+import numpy as np
+from mathutils import Vector
+
+from .errors import BakeInputError
+from .kernels import occlusion_weight
+from .normalization import hemisphere_weight
+from .plan import BakePlan
+from .reference import build_bvh, first_hit, ray_offset
+from .uv_raster import texel_surface_samples
+
+# Rays one reference bake may trace (about 4 us each here): beyond this it would run for
+# minutes, which nobody asks for by accident.
+MAX_REFERENCE_RAYS = 20_000_000
+
+
+class ReferenceBaker:
+    """Ray-traced twin of the GPU bake passes for one plan."""
+
+    @staticmethod
+    def rays_needed(plan: BakePlan) -> int:
+        return plan.settings.size ** 2 * plan.settings.directions
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        """Refuse a bake that would trace more than MAX_REFERENCE_RAYS rays."""
+        rays = cls.rays_needed(plan)
+        if rays > MAX_REFERENCE_RAYS:
+            raise BakeInputError(
+                f"the reference (CPU ray tracing) bake would trace up to {rays:,} rays (size^2 x directions), "
+                f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
+
+    def __init__(self, plan: BakePlan) -> None:
+        self.plan = plan
+        size = plan.settings.size
+        face, bary, _hits = texel_surface_samples(plan.target_uvs.astype(np.float64), size)
+        covered = face >= 0
+        f = face[covered]
+        b = bary[covered]
+        corners = plan.target_corners.astype(np.float64)
+        lit = plan.target_faces[f, 3] > 0.0
+        self.texel = np.flatnonzero(covered.ravel())[lit]
+        f, b = f[lit], b[lit]
+        self.points = np.einsum("nk,nkd->nd", b, plan.target_positions[f].astype(np.float64))
+        shading = np.einsum("nk,nkd->nd", b, corners[f, :, :3])
+        self.shading = shading / np.maximum(np.linalg.norm(shading, axis=1, keepdims=True), 1e-30)
+        self.inv_s = np.einsum("nk,nk->n", b, corners[f, :, 3])
+        self.geometric = plan.target_faces[f, :3].astype(np.float64)
+        scene = np.concatenate([plan.target_positions, plan.occluder_positions]).astype(np.float64)
+        self.bvh = build_bvh(scene)
+        self.face_normals = (np.concatenate([plan.target_faces[:, :3], plan.occluder_normals]).astype(np.float64)
+                             if plan.settings.ignore_back_faces else None)
+        flat = scene.reshape(-1, 3)
+        radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
+        self.origins = [Vector(p + n * ray_offset(p, radius))
+                        for p, n in zip(self.points, self.geometric)]
+        self.offsets = np.array([ray_offset(p, radius) for p in self.points])
+        self.num = np.zeros(len(self.points))
+        self.den = np.zeros(len(self.points))
+        self.stats = dict(receivers=len(self.points), rays_traced=0, rays_below_surface=0, directions_done=0,
+                          shading_normals=plan.smooth_shading)
+        self._freed = False
+
+    def run_direction(self, index: int) -> None:
+        """Trace direction `index` of the plan from every receiver and add its terms."""
+        settings = self.plan.settings
+        omega = self.plan.directions[index]
+        weight = hemisphere_weight(self.shading @ omega, settings.weighting) * self.inv_s
+        above = self.geometric @ omega > 0.0
+        reach = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 1e30
+        dists = np.zeros(len(self.points))  # below the true surface: occluded
+        ray_cast = self.bvh.ray_cast
+        traced = np.flatnonzero(above & (weight > 0.0))
+        for i in traced:
+            dists[i] = first_hit(ray_cast, self.origins[i], omega, reach, self.offsets[i], self.face_normals)
+        visible = 1.0 - occlusion_weight(dists, self.plan.max_distance_normalized if settings.max_distance > 0.0
+                                         else 0.0, settings.falloff)
+        self.num += weight * visible
+        self.den += weight
+        self.stats["rays_traced"] += len(traced)
+        self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above).sum())
+        self.stats["directions_done"] += 1
+
+    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
+        """(numerator, denominator), each (size, size) float64."""
+        size = self.plan.settings.size
+        num = np.zeros(size * size)
+        den = np.zeros(size * size)
+        num[self.texel] = self.num
+        den[self.texel] = self.den
+        return num.reshape(size, size), den.reshape(size, size)
+
+    def free(self) -> None:
+        """Nothing on the GPU; drops the BVH."""
+        self.bvh = None
+        self._freed = True

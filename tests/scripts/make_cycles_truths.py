@@ -1,0 +1,69 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Cycles' own AO bakes of tests/shading_scenes.py's cases: the truths of
+tests/test_shading_normals.py (Cycles CPU, 1024 samples, no adaptive sampling, no denoising,
+AO distance 1e6 = unlimited, margin 0, the mesh's own shading).
+
+    .venv/bin/python tests/scripts/make_cycles_truths.py [case ...]
+
+Writes tests/data/cycles_<case>.npz: ao and ao_seed1 (256, 256) float16 (row 0 at v = 0),
+two bakes with Cycles seeds 0 and 1, whose difference measures Cycles' own noise; uvs
+(F, 3, 2) float32 (the layout baked); samples; blender (version string).
+"""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import shading_scenes as cases  # noqa: E402
+
+
+def cycles_ao(obj: bpy.types.Object, size: int, samples: int, seed: int = 0) -> np.ndarray:
+    img = bpy.data.images.new(f"truth{seed}", size, size, float_buffer=True)
+    img.colorspace_settings.name = 'Non-Color'
+    mat = bpy.data.materials.new("bake")
+    if mat.node_tree is None:
+        mat.use_nodes = True
+    tex = mat.node_tree.nodes.new('ShaderNodeTexImage')
+    tex.image = img
+    mat.node_tree.nodes.active = tex
+    obj.data.materials.clear()
+    obj.data.materials.append(mat)
+    scene = bpy.context.scene
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.samples = samples
+    scene.cycles.seed = seed
+    scene.world = bpy.data.worlds.new("truth")
+    scene.world.light_settings.distance = 1e6
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.bake(type='AO', use_clear=True, margin=0)
+    px = np.empty(size * size * 4, np.float32)
+    img.pixels.foreach_get(px)
+    return px.reshape(size, size, 4)[..., 0].copy()
+
+
+def main(names: list[str]) -> int:
+    for name in names or list(cases.CASES):
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        uvs = cases.corner_uvs(name)
+        obj = cases.build_object(name, uvs)
+        t = time.perf_counter()
+        runs = [cycles_ao(obj, cases.TRUTH_SIZE, cases.TRUTH_SPP, seed) for seed in (0, 1)]
+        np.savez_compressed(cases.truth_path(name), ao=runs[0].astype(np.float16), ao_seed1=runs[1].astype(np.float16),
+                            uvs=uvs.astype(np.float32), samples=cases.TRUTH_SPP, blender=bpy.app.version_string)
+        print(f"{name}: {obj.data.polygons.__len__()} faces, {time.perf_counter() - t:.1f} s", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,87 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Blender scenes shaded the way artists shade them, built the same way by the Cycles truth
+script (tests/scripts/make_cycles_truths.py) and by the tests that compare with it.
+
+Each case: a mesh from tests/data (or samples/), a UV layout (its own, or xatlas's stored
+with the truth), and a shading: smooth, smooth with sharp edges by angle, or custom normals.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from hao_addon.core.objfile import read_obj
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "tests" / "data"
+TRUTH_SIZE = 256
+TRUTH_SPP = 1024
+
+# name: (mesh file, shading). Cycles' shadow-terminator geometry offset (a per-object
+# setting, default 0.1) lifts rays that leave near the terminator off the flat facets towards
+# the smooth surface (Hanika 2021); HAO does not model it yet. On smooth meshes it changes
+# little (their normals stay close to the faces'), but on the strongly bent custom normals of
+# spot_custom it makes Cycles 0.037 brighter on average, so that case's truth is baked with
+# the offset off, where the definitions agree (tests/scripts/make_cycles_truths.py).
+CASES = {
+    "spot_smooth": (ROOT / "samples" / "spot.obj", "smooth"),
+    "rocker_smooth": (DATA / "rocker-arm.obj", "smooth"),
+    "fandisk_sharp": (DATA / "fandisk.obj", "sharp"),
+    "spot_custom": (ROOT / "samples" / "spot.obj", "custom"),
+}
+SHARP_ANGLE = math.radians(30.0)
+NO_TERMINATOR_OFFSET = {"spot_custom"}
+
+
+def truth_path(name: str) -> Path:
+    return DATA / f"cycles_{name}.npz"
+
+
+def corner_uvs(name: str, size: int = TRUTH_SIZE) -> np.ndarray:
+    """(F, 3, 2) the case's UV layout: the file's own, else xatlas's (made once by the truth
+    script and read back from the truth file, so tests bake exactly what Cycles baked)."""
+    path, _ = CASES[name]
+    v, t, uv, tu = read_obj(path)
+    if uv is not None:
+        return uv[tu]
+    if truth_path(name).exists():
+        return np.load(truth_path(name))["uvs"].astype(np.float64)
+    from hao_addon.core.unwrap import xatlas_unwrap
+    return xatlas_unwrap(v, t, size)
+
+
+def custom_vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(V, 3) custom normals as a stylized-shading artist sets them: the smooth normal bent
+    halfway towards the direction from the mesh's centre (rounder, softer shading)."""
+    from hao_addon.core.geometry import smooth_vertex_normals
+    corner = smooth_vertex_normals(vertices[triangles])
+    smooth = np.zeros_like(vertices)
+    smooth[triangles.ravel()] = corner.reshape(-1, 3)
+    radial = vertices - vertices.mean(axis=0)
+    radial /= np.maximum(np.linalg.norm(radial, axis=1, keepdims=True), 1e-12)
+    bent = smooth + radial
+    return bent / np.maximum(np.linalg.norm(bent, axis=1, keepdims=True), 1e-12)
+
+
+def build_object(name: str, uvs: np.ndarray) -> bpy.types.Object:
+    """The case's object in the current scene, named after the case, with UV map 'UVMap'."""
+    path, shading = CASES[name]
+    v, t, _uv, _tu = read_obj(path)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(v.tolist(), [], t.tolist())
+    layer = mesh.uv_layers.new(name="UVMap")
+    layer.uv.foreach_set("vector", uvs.reshape(-1).astype(np.float32))  # loops follow the triangles
+    mesh.shade_smooth()
+    if shading == "sharp":
+        mesh.set_sharp_from_angle(angle=SHARP_ANGLE)
+    elif shading == "custom":
+        mesh.normals_split_custom_set_from_vertices(custom_vertex_normals(v, t).tolist())
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    if name in NO_TERMINATOR_OFFSET:
+        obj.shadow_terminator_geometry_offset = 0.0
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
