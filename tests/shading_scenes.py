@@ -81,7 +81,8 @@ def build_object(name: str, uvs: np.ndarray) -> bpy.types.Object:
         mesh.normals_split_custom_set_from_vertices(custom_vertex_normals(v, t).tolist())
     mesh.update()
     obj = bpy.data.objects.new(name, mesh)
-    if name in NO_TERMINATOR_OFFSET:
+    if name in NO_TERMINATOR_OFFSET and hasattr(obj, "shadow_terminator_geometry_offset"):
+        # Only Cycles reads it (the truths were made on 5.2; bpy 4.2 names no such property).
         obj.shadow_terminator_geometry_offset = 0.0
     bpy.context.scene.collection.objects.link(obj)
     return obj
