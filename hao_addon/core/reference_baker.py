@@ -66,14 +66,12 @@ class ReferenceBaker:
                              if plan.settings.ignore_back_faces else None)
         flat = scene.reshape(-1, 3)
         radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
-        self.origins = [Vector(p + n * ray_offset(p, radius))
-                        for p, n in zip(self.points, self.geometric)]
         self.offsets = np.array([ray_offset(p, radius) for p in self.points])
+        self.origins = [Vector(p) for p in self.points + self.geometric * self.offsets[:, None]]
         self.num = np.zeros(len(self.points))
         self.den = np.zeros(len(self.points))
         self.stats = dict(receivers=len(self.points), rays_traced=0, rays_below_surface=0, directions_done=0,
                           shading_normals=plan.smooth_shading)
-        self._freed = False
 
     def run_direction(self, index: int) -> None:
         """Trace direction `index` of the plan from every receiver and add its terms."""
@@ -107,4 +105,3 @@ class ReferenceBaker:
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""
         self.bvh = None
-        self._freed = True
