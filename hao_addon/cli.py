@@ -19,7 +19,7 @@ from pathlib import Path
 
 from . import __version__
 from .cli_io import (EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, check_signals,
-                     deferred_signals, signals_as_exceptions)
+                     deferred_signals, pending_signal, signals_as_exceptions)
 from .cli_options import add_setting_options, option_for, settings_from_args
 from .core.errors import BakeInputError
 from .core.setting_spec import SettingError
@@ -114,6 +114,7 @@ def load_scene(path: Path) -> None:
             bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
             return
         bpy.ops.wm.read_factory_settings(use_empty=True)
+        check_signals()  # it registers the bundled add-ons: one interrupted there is missing
         if ext == ".obj":
             bpy.ops.wm.obj_import(filepath=str(path))
         else:
@@ -323,6 +324,8 @@ def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
     """(exit code, one-line message) for any exception."""
     import signal
 
+    if pending_signal() is not None and not isinstance(exc, (KeyboardInterrupt, Terminated)):
+        exc = Terminated() if pending_signal() == signal.SIGTERM else KeyboardInterrupt()
     if isinstance(exc, KeyboardInterrupt):
         return EXIT_INTERRUPTED[signal.SIGINT], "interrupted (SIGINT): nothing was written"
     if isinstance(exc, Terminated):

@@ -80,6 +80,12 @@ def check_signals() -> None:
         _raise_for(_PENDING[0])
 
 
+def pending_signal() -> int | None:
+    """The first signal received in this run, or None: an error raised after one was
+    swallowed (an add-on whose registration it interrupted has no operators) is its echo."""
+    return _PENDING[0] if _PENDING else None
+
+
 @contextlib.contextmanager
 def signals_as_exceptions() -> Iterator[None]:
     """SIGINT raises KeyboardInterrupt and SIGTERM raises Terminated while inside (the main
