@@ -18,6 +18,7 @@ import numpy as np
 from .core.geometry import TriangleSoup
 from .core.errors import BakeInputError
 from .core.plan import make_plan
+from .core.projection import HighToLow
 from .core.seams import finalize_map
 from .core.settings import BakeSettings
 
@@ -37,10 +38,17 @@ _CACHE: "OrderedDict[str, BakeResult]" = OrderedDict()
 _CACHE_SIZE = 8
 
 
-def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings) -> str:
+def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+            high_to_low: HighToLow | None) -> str:
     h = hashlib.blake2b(digest_size=20)
     h.update(repr(settings.cache_key()).encode())
-    for soup in [target, *occluders]:
+    sources = []
+    if high_to_low is not None:
+        sources = high_to_low.sources
+        h.update(b"|high-to-low|%d|" % len(sources))
+        for extra in (high_to_low.extrusion_normals, high_to_low.cage):
+            h.update(b"|none|" if extra is None else np.ascontiguousarray(extra).tobytes())
+    for soup in [target, *sources, *occluders]:
         h.update(np.ascontiguousarray(soup.positions).tobytes())
         h.update(b"|uv|" if soup.uvs is not None else b"|no-uv|")
         if soup.uvs is not None:
@@ -54,21 +62,22 @@ def clear_cache() -> None:
 
 
 def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-               use_cache: bool = True) -> Generator[float, None, BakeResult]:
+               use_cache: bool = True, high_to_low: HighToLow | None = None) -> Generator[float, None, BakeResult]:
     """Bake `target` (with UVs) against itself and `occluders`; yields progress in [0, 1].
+    With `high_to_low`, bake its sources onto the target's UVs (Selected to Active).
 
     A re-bake of identical geometry, UVs and settings returns the cached result at once
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
     """
     t0 = time.perf_counter()
-    key = _digest(target, occluders, settings) if use_cache else None
+    key = _digest(target, occluders, settings, high_to_low) if use_cache else None
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
         yield 1.0
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True})
 
-    plan = make_plan(target, occluders, settings)
+    plan = make_plan(target, occluders, settings, high_to_low)
     from .bakers import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
     baker_cls = baker_for(settings.resolved_method)
     baker_cls.check_limits(plan)
@@ -94,9 +103,10 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
 
 
 def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-         progress: Callable[[float], None] | None = None, use_cache: bool = True) -> BakeResult:
+         progress: Callable[[float], None] | None = None, use_cache: bool = True,
+         high_to_low: HighToLow | None = None) -> BakeResult:
     """Blocking bake (drains bake_steps)."""
-    steps = bake_steps(target, occluders, settings, use_cache)
+    steps = bake_steps(target, occluders, settings, use_cache, high_to_low)
     try:
         while True:
             try:
@@ -109,4 +119,4 @@ def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSett
         steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
 
 
-__all__ = ["BakeInputError", "BakeResult", "bake", "bake_steps", "clear_cache"]
+__all__ = ["BakeInputError", "BakeResult", "HighToLow", "bake", "bake_steps", "clear_cache"]

@@ -55,7 +55,15 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
     b.add_argument("--object", default="", help="mesh to bake (default: the mesh with the most faces)")
     b.add_argument("--occluders", choices=("target", "visible"), default="visible",
-                   help="target: self-occlusion only; visible: every visible mesh occludes (default)")
+                   help="target: self-occlusion only (with --high-poly: the high-poly only); visible: every "
+                        "visible mesh occludes (default)")
+    b.add_argument("--high-poly", action="append", default=None, metavar="PATH_OR_NAME",
+                   help="Selected to Active: bake this high-poly onto the low-poly's UVs (repeatable): a "
+                        ".obj/.glb/.gltf/.blend file whose meshes are the sources, or the name of a mesh in INPUT; "
+                        "the low-poly (--object, default the largest other mesh) does not occlude")
+    b.add_argument("--cage", default="", metavar="NAME",
+                   help="Selected to Active: a mesh in INPUT with the low-poly's topology that the rays start from "
+                        "(instead of --cage-extrusion)")
     _add_run_options(b)
 
     r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
@@ -130,10 +138,70 @@ def _last_line(exc: BaseException) -> str:
     return text.removeprefix("Error: ")
 
 
-def pick_target(name: str):
+def import_meshes(path: Path) -> list:
+    """Add the meshes of a .obj/.glb/.gltf/.blend file to the current scene; returns them."""
     import bpy
 
-    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH']
+    before = set(bpy.data.objects)
+    try:
+        ext = path.suffix.lower()
+        if ext == ".blend":
+            with bpy.data.libraries.load(str(path)) as (data_from, data_to):
+                data_to.objects = list(data_from.objects)
+            for obj in data_to.objects:
+                if obj is not None and obj.type == 'MESH':
+                    bpy.context.scene.collection.objects.link(obj)
+        elif ext == ".obj":
+            bpy.ops.wm.obj_import(filepath=str(path))
+        else:
+            bpy.ops.import_scene.gltf(filepath=str(path))
+    except (RuntimeError, ValueError, KeyError, OSError, UnicodeError) as exc:
+        check_signals()
+        raise CLIError(f"cannot read '{path.name}': {_last_line(exc)}") from None
+    check_signals()
+    meshes = [o for o in bpy.data.objects if o not in before and o.type == 'MESH']
+    if not meshes:
+        raise CLIError(f"--high-poly '{path.name}' holds no mesh")
+    return meshes
+
+
+def pick_high_poly(specs: list[str]) -> list:
+    """The Selected-to-Active sources: each spec a mesh file to add, or a mesh's name."""
+    import bpy
+
+    out = []
+    for spec in specs:
+        path = Path(spec)
+        if path.suffix.lower() in INPUT_FORMATS and bpy.data.objects.get(spec) is None:
+            try:
+                checked = check_input(path, INPUT_FORMATS)
+            except CLIError as exc:
+                raise CLIError(f"--high-poly: {exc}") from None
+            out += import_meshes(checked)
+            continue
+        obj = bpy.data.objects.get(spec)
+        if obj is None or obj.type != 'MESH':
+            meshes = ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
+            raise CLIError(f"--high-poly '{spec}' is neither a mesh file nor a mesh in the input (meshes: {meshes})")
+        out.append(obj)
+    return out
+
+
+def pick_mesh(name: str, option: str):
+    import bpy
+
+    obj = bpy.data.objects.get(name)
+    if obj is None or obj.type != 'MESH':
+        meshes = ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
+        raise CLIError(f"{option}: no mesh object named '{name}' (meshes: {meshes})")
+    return obj
+
+
+def pick_target(name: str, exclude: tuple = ()):
+    """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
+    import bpy
+
+    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
     if name:
         obj = bpy.data.objects.get(name)
         if obj is None or obj.type != 'MESH':
@@ -166,11 +234,19 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         progress.update("loading")
         load_scene(source)
     check_signals()
-    target = pick_target(args.object)
+    high_poly = pick_high_poly(args.high_poly) if args.high_poly else None
+    cage = pick_mesh(args.cage, "--cage") if args.cage else None
+    if cage is not None and high_poly is None:
+        raise CLIError("--cage needs --high-poly (Selected to Active)")
+    target = pick_target(args.object, tuple(high_poly or ()) + ((cage,) if cage else ()))
+    if high_poly is not None:
+        report.settings["high_poly"] = [o.name for o in high_poly]
+        report.settings["cage"] = cage.name if cage else ""
     request = BakeRequest(targets=[target], settings=settings,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
-                          filepath=str(Path(os.path.abspath(args.out))), source_path=str(source))
+                          filepath=str(Path(os.path.abspath(args.out))), source_path=str(source),
+                          high_poly=high_poly, cage=cage)
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     start_gpu()
     t0 = time.perf_counter()
@@ -192,7 +268,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
                                    uv_map_created=any(n == uv_name for _m, n in job.created_uv),
                                    covered_texels=st["covered_texels"], method=st["method"],
-                                   smooth_corners=st["smooth_corners"]))
+                                   smooth_corners=st["smooth_corners"],
+                                   **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {})))
         report.outputs.append(out)
         report.warnings.extend(st.get("warnings", []))
         lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "

@@ -88,7 +88,7 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         return True
 
     def _make_job(self, context) -> BakeJob:
-        request = context.scene.hao_bake.to_request(bake_targets(context))
+        request = context.scene.hao_bake.to_request(bake_targets(context), context.active_object)
         return BakeJob(request, context.evaluated_depsgraph_get)
 
     def _report_done(self, job: BakeJob) -> None:

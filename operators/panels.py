@@ -32,6 +32,16 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "normals")
         col.prop(settings, "ignore_back_faces")
         col.prop(settings, "occluders")
+        col.prop(settings, "samples_per_texel")
+        col.separator()
+        col.prop(settings, "selected_to_active")
+        sub = col.column()
+        sub.active = settings.selected_to_active
+        sub.prop(settings, "cage_object")
+        extrusion = sub.column()
+        extrusion.active = settings.selected_to_active and settings.cage_object is None
+        extrusion.prop(settings, "cage_extrusion")
+        sub.prop(settings, "max_ray_distance")
         col.separator()
         col.prop(settings, "uv_mode")
         if settings.uv_mode == 'NAMED':

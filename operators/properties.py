@@ -33,6 +33,15 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Save To", description="Also write the map to this .png (16-bit) or .exr (32-bit float) file; "
                                     "{object} is replaced by the object's name", default="", subtype='FILE_PATH',
         options=compat.path_property_options())
+    selected_to_active: BoolProperty(
+        name="Selected to Active",
+        description="Bake the other selected meshes (high-poly) onto the active one's UVs, as Cycles does: "
+                    "they occlude, the active mesh does not",
+        default=False)
+    cage_object: PointerProperty(
+        name="Cage Object", type=bpy.types.Object, poll=lambda _self, obj: obj.type == 'MESH',
+        description="Selected to Active: rays start on this copy of the active mesh (same topology, moved "
+                    "vertices) instead of the cage extrusion")
     wire_material: BoolProperty(
         name="Add to Material", description="Add the AO image to the object's material and multiply it into Base Color",
         default=False)
@@ -40,10 +49,18 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
     def to_settings(self) -> BakeSettings:
         return settings_from(self, BakeSettings)
 
-    def to_request(self, targets: list) -> BakeRequest:
+    def to_request(self, targets: list, active=None) -> BakeRequest:
+        """targets: the selected meshes; with Selected to Active the active one is baked and
+        the others (not the cage) are its high-poly sources."""
         uv = {'AUTO': "AUTO", 'ACTIVE': "", 'NAMED': self.uv_map}[self.uv_mode]
+        high_poly, cage = None, None
+        if self.selected_to_active:
+            cage = self.cage_object
+            high_poly = [o for o in targets if o != active and o != cage]
+            targets = [active] if active is not None else []
         return BakeRequest(targets=targets, settings=self.to_settings(), occluders=self.occluders, uv_map=uv,
-                           image=self.image, filepath=self.filepath, wire_material=self.wire_material)
+                           image=self.image, filepath=self.filepath, wire_material=self.wire_material,
+                           high_poly=high_poly, cage=cage)
 
 
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))

@@ -284,3 +284,61 @@ def test_an_error_after_a_swallowed_signal_is_that_signal(signum, code):
     finally:
         cli_io._PENDING.clear()
     assert got == code and message.endswith("nothing was written"), message
+
+
+def write_obj(path: Path, objects: dict) -> None:
+    """A Wavefront file of named triangle soups (UVs where a soup has them)."""
+    lines, base = [], 1
+    for name, soup in objects.items():
+        lines.append(f"o {name}\n")
+        lines += [f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in soup.positions.reshape(-1, 3)]
+        if soup.uvs is not None:
+            lines += [f"vt {u:.9g} {v:.9g}\n" for u, v in soup.uvs.reshape(-1, 2)]
+        for f in range(soup.face_count):
+            idx = [base + 3 * f + k for k in range(3)]
+            lines.append("f " + " ".join(f"{i}/{i}" if soup.uvs is not None else str(i) for i in idx) + "\n")
+        base += 3 * soup.face_count
+    path.write_text("".join(lines))
+
+
+def test_high_poly_from_a_file_or_by_name(dirs):
+    """Selected to Active on the command line: a low-poly plane over a relief (a ball on a
+    floor) from a second file, or by object name from one file; misses are reported."""
+    from hao_addon.core import scenes
+
+    out, tmp = dirs
+    low = scenes.grid_plane(4.0, 4, z=1.2)
+    floor, ball = scenes.grid_plane(200.0, 16), scenes.uv_sphere(0.5, (0, 0, 0.5), 32, 16)
+    floor.uvs = ball.uvs = None
+    write_obj(tmp.parent / "low.obj", {"low": low})
+    write_obj(tmp.parent / "high.obj", {"floor": floor, "ball": ball})
+    write_obj(tmp.parent / "both.obj", {"low": low, "floor": floor, "ball": ball})
+    report = out / "r.json"
+    common = ["--size", "64", "--directions", "64", "--json", report, "--quiet"]
+    proc = run(["bake", tmp.parent / "low.obj", "--high-poly", tmp.parent / "high.obj", "--out", out / "a.png",
+                *common], tmp)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(report.read_text())
+    assert sorted(data["settings"]["high_poly"]) == ["ball", "floor"] and data["objects"][0]["name"] == "low"
+    assert data["objects"][0]["missed_texels"] == 0 and (out / "a.png").is_file()
+    proc = run(["bake", tmp.parent / "both.obj", "--high-poly", "floor", "--high-poly", "ball",
+                "--max-ray-distance", "0.8", "--out", out / "b.png", *common], tmp)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(report.read_text())
+    assert data["objects"][0]["name"] == "low"  # the largest mesh that is not a source
+    assert data["objects"][0]["missed_texels"] > 1000
+    assert any("found no high-poly surface" in w for w in data["warnings"])
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--high-poly", "missing.obj"], "--high-poly: input file not found"),
+    (["--high-poly", "nosuch"], "--high-poly 'nosuch' is neither a mesh file nor a mesh in the input"),
+    (["--cage", "spot"], "--cage needs --high-poly"),
+    (["--high-poly", "spot", "--object", "spot"], "cannot be both the high-poly and the low-poly"),
+])
+def test_high_poly_mistakes_are_one_line(dirs, extra, message):
+    out, tmp = dirs
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / "a.png", *extra], tmp)
+    assert proc.returncode == 2 and proc.stderr.strip() == f"hao: error: {proc.stderr.strip()[12:]}"
+    assert message in proc.stderr and len(proc.stderr.splitlines()) == 1, proc.stderr
+    assert list(out.iterdir()) == [] and list(tmp.iterdir()) == []

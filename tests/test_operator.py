@@ -282,3 +282,34 @@ def test_tiny_and_huge_meshes_without_uvs_bake(scene, scale):
     px = np.empty(128 * 128 * 4, np.float32)
     bpy.data.images[f"{obj.name}_AO"].pixels.foreach_get(px)
     assert np.isfinite(px).all() and px.reshape(-1, 4)[:, 0].max() == 1.0  # a lone convex cube is open
+
+
+def test_selected_to_active_bakes_the_high_poly_onto_the_active_mesh(scene, capfd):
+    """The checkbox: the active mesh (a plane over a ball on a floor) receives, the other
+    selected meshes are its sources and occlude, it does not; only its image is made, and a
+    large miss count is reported as a warning. A cage object with other topology is refused."""
+    from hao_addon.blender.images import image_pixels_gray
+    low = soup_to_object(scenes.grid_plane(4.0, 4, z=1.2), "Low")
+    floor = soup_to_object(scenes.grid_plane(200.0, 16), "Floor", uv=False)
+    ball = soup_to_object(scenes.uv_sphere(0.5, (0, 0, 0.5), 32, 16), "Ball", uv=False)
+    before = uv_array(low.data, "UVMap")
+    small_settings(scene, selected_to_active=True, occluders='SELECTED')
+    select_only(low, floor, ball)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    ao = image_pixels_gray(bpy.data.images["Low_AO"])
+    assert "Floor_AO" not in bpy.data.images and "Ball_AO" not in bpy.data.images
+    assert ao[2, 2] > 0.95 and ao[64, 64] > 0.9  # far floor and the ball's top: open, not under the plane
+    assert 0.3 < ao[64, 50] < 0.9  # the floor next to the ball
+    np.testing.assert_array_equal(uv_array(low.data, "UVMap"), before)
+    capfd.readouterr()
+    small_settings(scene, selected_to_active=True, max_ray_distance=0.8)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert "found no high-poly surface" in capfd.readouterr().out
+    scene.hao_bake.cage_object = ball
+    select_only(low, floor)
+    with pytest.raises(RuntimeError, match="cage 'Ball' has"):
+        bpy.ops.object.hao_bake_ao()
+    scene.hao_bake.cage_object = None
+    select_only(low)
+    with pytest.raises(RuntimeError, match="select the high-poly meshes besides 'Low'"):
+        bpy.ops.object.hao_bake_ao()

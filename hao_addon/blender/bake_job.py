@@ -16,6 +16,7 @@ import bpy
 
 from ..bake import BakeResult, bake_steps
 from ..core.imageio import check_writable, write_ao_file
+from ..core.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.settings import BakeSettings
 from ..core.unwrap import unwrap_steps
@@ -34,7 +35,10 @@ class BakeRequest:
     AO_UV unwrapped with xatlas.
     image: an existing image to overwrite (one target only), else '<object>_AO' is created.
     filepath: '' or a .png/.exr path; '{object}' in it becomes each object's name (with several
-    targets and no token, '_{object}' is appended)."""
+    targets and no token, '_{object}' is appended).
+    high_poly: Selected to Active (Cycles' definition): these meshes are baked onto the one
+    target's UVs and occlude, the target does not; cage: an optional cage object (the
+    target's topology, moved vertices) the rays start from."""
 
     targets: list
     settings: BakeSettings
@@ -45,6 +49,8 @@ class BakeRequest:
     filepath: str = ""
     wire_material: bool = False
     source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
+    high_poly: list | None = None
+    cage: "bpy.types.Object | None" = None
 
 
 def output_path_for(request: BakeRequest, obj) -> str:
@@ -62,6 +68,10 @@ def output_path_for(request: BakeRequest, obj) -> str:
 def validate_request(request: BakeRequest) -> None:
     """Raise BakeInputError for anything that can be refused before touching the scene."""
     request.settings.validated()
+    if request.high_poly is not None:
+        _validate_high_to_low(request)
+    elif request.cage is not None:
+        raise BakeInputError("a cage object is used only with Selected to Active")
     if not request.targets:
         raise BakeInputError("no mesh selected: select one or more mesh objects to bake")
     for obj in request.targets:
@@ -89,6 +99,24 @@ def validate_request(request: BakeRequest) -> None:
         writers[path] = obj.name
         size = request.settings.size
         check_writable(path, size, size, 1, source=request.source_path or None)
+
+
+def _validate_high_to_low(request: BakeRequest) -> None:
+    if len(request.targets) != 1 or request.targets[0] is None:
+        raise BakeInputError("Selected to Active bakes onto one low-poly mesh: make it the active object")
+    if not request.high_poly:
+        raise BakeInputError(f"Selected to Active: select the high-poly meshes besides '{request.targets[0].name}'")
+    low = request.targets[0]
+    for obj in request.high_poly:
+        if obj.type != 'MESH':
+            raise BakeInputError(f"high-poly '{obj.name}' is not a mesh")
+        if obj == low or obj == request.cage:
+            raise BakeInputError(f"'{obj.name}' cannot be both the high-poly and the low-poly or cage")
+        if len(obj.data.polygons) == 0:
+            raise BakeInputError(f"high-poly '{obj.name}' has no faces")
+    cage = request.cage
+    if cage is not None and (cage.type != 'MESH' or cage == low):
+        raise BakeInputError(f"the cage '{cage.name}' must be a mesh other than the low-poly")
 
 
 def _with_status(steps: Generator, fraction: float, text: str) -> Generator[tuple[float, str], None, object]:
@@ -155,6 +183,18 @@ class BakeJob:
                 out.append(o)
         return out
 
+    def _high_to_low(self, low, depsgraph) -> HighToLow:
+        """The Selected-to-Active request of the low-poly: its sources with their shading,
+        the normals Blender extrudes along, the cage's evaluated corners."""
+        req = self.request
+        sources = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=req.settings.normals == "mesh")
+                   for o in req.high_poly]
+        normals, linear = mesh_data.extrusion_normals(low, depsgraph)
+        cage = None
+        if req.cage is not None:
+            cage = mesh_data.evaluated_soup(req.cage, depsgraph, None, shading_normals=False).positions
+        return HighToLow(sources, normals, cage, req.cage.name if req.cage is not None else "cage", linear)
+
     # -- running ---------------------------------------------------------------------------
     def steps(self) -> Generator[tuple[float, str], None, None]:
         """Yield (fraction done, status text) after each light direction."""
@@ -167,9 +207,11 @@ class BakeJob:
         for k, obj in enumerate(req.targets):
             target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name],
                                               shading_normals=req.settings.normals == "mesh")
+            high_to_low = self._high_to_low(obj, depsgraph) if req.high_poly is not None else None
+            skip = set(req.high_poly or ()) | {req.cage}
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
-                         for o in self._occluder_objects(obj)]
-            gen = bake_steps(target, occluders, req.settings)
+                         for o in self._occluder_objects(obj) if o not in skip]
+            gen = bake_steps(target, occluders, req.settings, high_to_low=high_to_low)
             try:
                 while True:
                     try:

@@ -74,6 +74,34 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
         obj_eval.to_mesh_clear()
 
 
+def extrusion_normals(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
+    """What Blender's Selected to Active pushes the cage along (render/intern/bake.cc):
+    per evaluated triangle corner, the vertex normal on smooth faces and the face normal on
+    flat ones, in object space (custom normals and sharp edges play no part), corners in
+    evaluated_soup's order. Returns (normals (F, 3, 3), the object's linear map (3, 3))."""
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        _co, tri_verts, _tri_loops = _mesh_arrays(mesh)
+        linear = np.array(obj_eval.matrix_world, dtype=np.float64)[:3, :3]
+        if np.linalg.det(linear) < 0.0:
+            tri_verts = tri_verts[:, ::-1]
+        vertex_n = np.empty(len(mesh.vertices) * 3, np.float32)
+        mesh.vertex_normals.foreach_get("vector", vertex_n)
+        face_n = np.empty(len(mesh.polygons) * 3, np.float32)
+        mesh.polygon_normals.foreach_get("vector", face_n)
+        smooth = np.empty(len(mesh.polygons), bool)
+        mesh.polygons.foreach_get("use_smooth", smooth)
+        tri_face = np.empty(len(mesh.loop_triangles), np.int64)
+        mesh.loop_triangles.foreach_get("polygon_index", tri_face)
+        normals = vertex_n.reshape(-1, 3).astype(np.float64)[tri_verts]
+        flat = ~smooth[tri_face]
+        normals[flat] = face_n.reshape(-1, 3).astype(np.float64)[tri_face[flat]][:, None, :]
+        return normals, linear
+    finally:
+        obj_eval.to_mesh_clear()
+
+
 def base_mesh_triangles(obj: bpy.types.Object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Original (unevaluated) mesh: (positions (V, 3), triangles (F, 3), triangle loops (F, 3))."""
     return _mesh_arrays(obj.data)

@@ -16,6 +16,8 @@ from .errors import BakeInputError
 from .geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                        surface_holes, uv_areas, weld)
 from .normalization import corner_normalizers, face_normalizers
+from .projection import HighToLow, check_high_to_low, project, ray_starts
+from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
 from .views import OrthoView, fit_views
@@ -32,6 +34,13 @@ DENSITY_PERCENTILE = 0.10
 # that, the bake uses the footprint-splitting shader variant (slower, so only then).
 FOOTPRINT_SPLIT = 1.5
 DENSE_AREA_LIMIT = 0.005
+# Selected to Active: warn when more than this fraction of the sampled texels found no
+# high-poly surface (they are filled from their neighbours, as margin).
+MISSED_TEXELS_WARNING = 0.01
+# Selected-to-Active light views are fitted to the corners of grid cells this many light-view
+# pixels wide that hold receivers (plan.cell_corners): a few thousand points instead of
+# millions, for windows at most that much wider.
+VIEW_FIT_CELL = 16
 
 
 @dataclass
@@ -65,7 +74,29 @@ class BakePlan:
     # (core/geometry.surface_holes; [] when closed); None when not, or not needed (a max
     # distance or ignored back faces change what a depth map must hold).
     holes: list[np.ndarray] | None = None
+    # Selected to Active: the high-poly points the target's texels project to
+    # (core/projection.py); the target itself is then neither a receiver nor drawn.
+    projected: Receivers | None = None
     stats: dict = field(default_factory=dict)
+
+    @property
+    def target_drawn(self) -> bool:
+        """Whether the target occludes (not in Selected to Active, as in Cycles)."""
+        return self.projected is None
+
+    @property
+    def drawn_positions(self) -> np.ndarray:
+        """(F, 3, 3) float32 normalized: every triangle the light views draw, target first."""
+        if not self.target_drawn:
+            return self.occluder_positions
+        return np.concatenate([self.target_positions, self.occluder_positions])
+
+    @property
+    def drawn_normals(self) -> np.ndarray:
+        """(F, 3) float32 face normals of drawn_positions."""
+        if not self.target_drawn:
+            return self.occluder_normals
+        return np.concatenate([self.target_faces[:, :3], self.occluder_normals])
 
     @property
     def depth_map_culls_back_faces(self) -> bool:
@@ -120,8 +151,11 @@ def _check_finite(soup: TriangleSoup) -> None:
         raise BakeInputError(f"'{soup.name}' has NaN or infinite UV coordinates")
 
 
-def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings) -> BakePlan:
-    """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`."""
+def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+              high_to_low: HighToLow | None = None) -> BakePlan:
+    """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
+    with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
+    and the occluders occlude, the target does not)."""
     settings = settings.validated()
     if target.face_count == 0:
         raise BakeInputError(f"'{target.name}' has no faces to bake")
@@ -130,6 +164,9 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     _check_finite(target)
     for occ in occluders:
         _check_finite(occ)
+    if high_to_low is not None:
+        check_high_to_low(target, high_to_low)
+        occluders = [*high_to_low.sources, *occluders]
 
     normals, areas = face_normals_areas(target.positions)
     if not (areas > 0.0).any():
@@ -141,6 +178,8 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
+    if high_to_low is not None:  # the receivers lie on the sources
+        flat = np.concatenate([flat, *(s.positions.reshape(-1, 3) for s in high_to_low.sources)])
     centre, radius = bounding_sphere(flat)
     scale = radius if radius > 0.0 else 1.0
     t_pos = (target.positions - centre) / scale
@@ -182,7 +221,9 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     # The 10th area-percentile face density: 90 % of the surface gets at least
     # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
     density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
-    pixel_size = float(np.sqrt(density / settings.view_samples))
+    # The scatter's anti-aliasing: that many times more light-view pixels per texel.
+    scatter_samples = settings.view_samples * (settings.sample_count if settings.resolved_method == "scatter" else 1)
+    pixel_size = float(np.sqrt(density / scatter_samples))
     pixel_size = max(pixel_size, 2.0 / (MAX_VIEW_SIDE - 4))  # the target sphere has diameter 2
 
     # Fraction of the texels (UV area, not surface area: a small dense region can hold many
@@ -191,7 +232,12 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     uv_used = uv_area[useful]
     dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
-    drawn = np.concatenate([t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)])
+    projected, projection_stats = None, {}
+    if high_to_low is not None:
+        projected, projection_stats, uv_warnings = _project(target, high_to_low, settings, directions, centre, scale,
+                                                            pixel_size, uv_warnings)
+    drawn_parts = [o_pos.reshape(-1, 3)] if projected is not None else [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)]
+    drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
     holes = None
@@ -200,8 +246,11 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
         holes = surface_holes(drawn.reshape(-1, 3, 3), target_weld if len(o_pos) == 0 else None)
     closed = holes == []
     drawn_sphere = bounding_sphere(drawn)
-    # Distinct corners: a light view's window is fitted to them (shared corners once).
+    # Distinct corners: a light view's window is fitted to them (shared corners once); in
+    # Selected to Active the corners of the source triangles that receivers lie on.
     target_points = t_pos.reshape(-1, 3)[target_weld[0]]
+    if projected is not None:
+        target_points = projection_stats.pop("corners")
 
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
@@ -209,12 +258,57 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
                  dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
                  holes=-1 if holes is None else len(holes), smooth_corners=smooth_corners,
-                 warnings=uv_warnings, **uv_counters)
+                 samples_per_texel=settings.sample_count, warnings=uv_warnings, **uv_counters, **projection_stats)
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
                     pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere,
-                    dense_fraction > DENSE_AREA_LIMIT, smooth_corners > 0, closed, holes, stats)
+                    dense_fraction > DENSE_AREA_LIMIT,
+                    smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
+                    closed, holes, projected, stats)
+
+
+def cell_corners(points: np.ndarray, cell: float) -> np.ndarray:
+    """(k, 3) corners of the grid cells (side `cell`) that hold points (n, 3): a few points
+    whose projection along any direction covers the points' (light views are fitted to them)."""
+    keys = np.unique(np.floor(points / cell).astype(np.int64), axis=0)
+    offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    return ((keys[:, None, :] + offsets[None]) * cell).reshape(-1, 3)
+
+
+def _project(target: TriangleSoup, request: HighToLow, settings: BakeSettings, directions: np.ndarray,
+             centre: np.ndarray, scale: float, pixel_size: float, warnings: list[str]
+             ) -> tuple[Receivers, dict, list[str]]:
+    """The receivers of a Selected-to-Active bake: the source points the target's texel
+    samples project to (core/projection.py), with the sources' own shading normals. Returns
+    them, stats (and the normalized corners of the hit triangles under "corners"), warnings."""
+    texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
+    origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
+    triangles = np.concatenate([s.positions for s in request.sources])
+    hit_face, hit_bary = project(origins, rays, triangles, settings.max_ray_distance)
+    hit = hit_face >= 0
+    hf, hb = hit_face[hit], hit_bary[hit]
+    normals, _ = face_normals_areas(triangles)
+    mesh = settings.normals == "mesh"
+    shading_corners = np.concatenate([
+        corner_shading_normals(s.positions, s.normals if mesh else None, face_normals_areas(s.positions)[0])[0]
+        for s in request.sources])
+    shading = interpolate_unit(shading_corners, hf, hb)
+    geometric = normals[hf]
+    points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
+    receivers = Receivers(points, geometric, shading, exact_inverse_normalizers(shading, directions, settings.weighting),
+                          texel[hit])
+    sampled = np.unique(texel)
+    missed = len(sampled) - len(np.unique(receivers.texel))
+    if len(sampled) and missed > MISSED_TEXELS_WARNING * len(sampled):
+        warnings = [*warnings, f"{missed} of {len(sampled)} texels of '{target.name}' ({100.0 * missed / len(sampled):.1f} %) "
+                               f"found no high-poly surface and were filled from their neighbours: raise the cage "
+                               f"extrusion or the max ray distance, or use a cage object"]
+    smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
+    corners = cell_corners(points, VIEW_FIT_CELL * pixel_size) if len(points) else np.zeros((1, 3))
+    stats = dict(high_poly_faces=int(len(triangles)), projected_samples=int(len(texel)), missed_samples=int((~hit).sum()),
+                 missed_texels=int(missed), smooth_receivers=smooth, corners=corners)
+    return receivers, stats, warnings
 
 
 def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,

@@ -5,7 +5,8 @@
 Same interface as ScatterBaker and GatherBaker (check_limits, construction from a plan,
 run_direction, accumulated, stats, free) and behind the same factory (hao_addon.bakers), so
 every bake test runs it on the scenes the GPU passes bake. Receivers are the texel centres
-of the target's UV layout (as the gather's); per direction each adds (V w, w) with
+of the target's UV layout (as the gather's), their sub-texel samples, or the high-poly
+points of a Selected-to-Active bake (core/receivers.py); per direction each adds (V w, w) with
 w = weight(omega . n_s) / S interpolated like the GPU passes interpolate them, and V the
 visibility: 0 below the true surface (the terminator rule of Cycles' AO pass), else one ray
 towards the light with the plan's max distance, falloff and back-face rule. Slow (a Python
@@ -21,7 +22,7 @@ from .kernels import occlusion_weight
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from .reference import build_bvh, first_hit, ray_offset
-from .uv_raster import texel_surface_samples
+from .receivers import uv_receivers
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
 # minutes, which nobody asks for by accident.
@@ -33,7 +34,7 @@ class ReferenceBaker:
 
     @staticmethod
     def rays_needed(plan: BakePlan) -> int:
-        return plan.settings.size ** 2 * plan.settings.directions
+        return plan.settings.size ** 2 * plan.settings.sample_count * plan.settings.directions
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:
@@ -41,29 +42,22 @@ class ReferenceBaker:
         rays = cls.rays_needed(plan)
         if rays > MAX_REFERENCE_RAYS:
             raise BakeInputError(
-                f"the reference (CPU ray tracing) bake would trace up to {rays:,} rays (size^2 x directions), "
+                f"the reference (CPU ray tracing) bake would trace up to {rays:,} rays (size^2 x samples per texel x directions), "
                 f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
 
     def __init__(self, plan: BakePlan) -> None:
         self.plan = plan
-        size = plan.settings.size
-        face, bary, _hits = texel_surface_samples(plan.target_uvs.astype(np.float64), size)
-        covered = face >= 0
-        f = face[covered]
-        b = bary[covered]
-        corners = plan.target_corners.astype(np.float64)
-        lit = plan.target_faces[f, 3] > 0.0
-        self.texel = np.flatnonzero(covered.ravel())[lit]
-        f, b = f[lit], b[lit]
-        self.points = np.einsum("nk,nkd->nd", b, plan.target_positions[f].astype(np.float64))
-        shading = np.einsum("nk,nkd->nd", b, corners[f, :, :3])
-        self.shading = shading / np.maximum(np.linalg.norm(shading, axis=1, keepdims=True), 1e-30)
-        self.inv_s = np.einsum("nk,nk->n", b, corners[f, :, 3])
-        self.geometric = plan.target_faces[f, :3].astype(np.float64)
-        scene = np.concatenate([plan.target_positions, plan.occluder_positions]).astype(np.float64)
+        receivers = plan.projected
+        if receivers is None:
+            receivers = uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
+                                     plan.settings.size, plan.settings.sample_count)
+        receivers = receivers.subset(receivers.inv_s > 0.0)
+        self.texel = receivers.texel
+        self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
+        self.geometric = receivers.geometric
+        scene = plan.drawn_positions.astype(np.float64)
         self.bvh = build_bvh(scene)
-        self.face_normals = (np.concatenate([plan.target_faces[:, :3], plan.occluder_normals]).astype(np.float64)
-                             if plan.settings.ignore_back_faces else None)
+        self.face_normals = plan.drawn_normals.astype(np.float64) if plan.settings.ignore_back_faces else None
         flat = scene.reshape(-1, 3)
         radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
         self.offsets = np.array([ray_offset(p, radius) for p in self.points])
@@ -96,10 +90,8 @@ class ReferenceBaker:
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
         """(numerator, denominator), each (size, size) float64."""
         size = self.plan.settings.size
-        num = np.zeros(size * size)
-        den = np.zeros(size * size)
-        num[self.texel] = self.num
-        den[self.texel] = self.den
+        num = np.bincount(self.texel, weights=self.num, minlength=size * size)
+        den = np.bincount(self.texel, weights=self.den, minlength=size * size)
         return num.reshape(size, size), den.reshape(size, size)
 
     def free(self) -> None:

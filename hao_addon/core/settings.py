@@ -37,6 +37,12 @@ METHOD_CHOICES = (
                                            "for checking a GPU bake"),
 )
 METHODS = tuple(c.value for c in METHOD_CHOICES)
+SAMPLES_PER_TEXEL_CHOICES = (
+    Choice("1", "Off", "one sample at each texel centre"),
+    Choice("4", "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
+    Choice("9", "9 Samples", "a 3 x 3 grid of points in each texel, averaged"),
+    Choice("16", "16 Samples", "a 4 x 4 grid of points in each texel, averaged"),
+)
 
 
 @dataclass(frozen=True)
@@ -65,6 +71,19 @@ class BakeSettings:
     margin: int = setting(
         16, label="Margin", minimum=0, maximum=1024, unit="texels", subtype='PIXEL',
         description="texels grown past every UV island, so filtering never reads the background")
+    samples_per_texel: str = setting(
+        "1", label="Anti-Aliasing", noun="samples per texel", choices=SAMPLES_PER_TEXEL_CHOICES,
+        description="stratified points per texel, averaged, for silhouettes, thin features and UV edges "
+                    "(the scatter, which averages each texel's area already, takes that many times more "
+                    "light-view pixels per texel)")
+    cage_extrusion: float = setting(
+        0.0, label="Cage Extrusion", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
+        description="Selected to Active: how far each ray starts outside the low-poly, along its normals "
+                    "(Cycles' Extrusion)")
+    max_ray_distance: float = setting(
+        0.0, label="Max Ray Distance", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
+        description="Selected to Active: a high-poly surface farther than this from the ray start is not found; "
+                    "0 = no limit")
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
@@ -85,6 +104,11 @@ class BakeSettings:
         if self.method != "auto":
             return self.method
         return "scatter" if self.max_distance > 0.0 else "gather"
+
+    @property
+    def sample_count(self) -> int:
+        """Samples per texel as a number (1, 4, 9 or 16)."""
+        return int(self.samples_per_texel)
 
     def cache_key(self) -> tuple:
         return tuple(sorted(asdict(self).items()))

@@ -22,9 +22,10 @@ import gpu
 import numpy as np
 
 from ..core.face_chunks import face_chunks, hole_chunk_ranges_many
-from ..core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
+from ..core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, octahedral_coords, proximity_order
 from ..core.errors import BakeInputError
 from ..core.plan import BakePlan
+from ..core.receivers import Receivers, uv_receivers
 from . import util
 from .light_view import LightViewBaker, depth_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
@@ -87,6 +88,20 @@ GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
 # Dispatch only the entries of normal bins that can face a view (False: every entry; the
 # results are the same, tests/test_bake_analytic.py).
 NORMAL_BINNING = True
+# Texel centres of the target's own UVs are listed by a UV-space raster on the GPU (the fast
+# path); sub-texel samples and Selected-to-Active receivers are made on the CPU
+# (core/receivers.py) and uploaded. False: upload in every case (tests compare the two).
+GPU_TEXEL_LIST = True
+
+
+def cpu_receivers(plan: BakePlan) -> Receivers | None:
+    """The receivers the gather uploads, or None where its GPU raster lists them."""
+    if plan.projected is not None:
+        return plan.projected
+    if plan.settings.sample_count == 1 and GPU_TEXEL_LIST:
+        return None
+    return uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
+                        plan.settings.size, plan.settings.sample_count)
 
 
 def views_per_dispatch(plan: BakePlan) -> int:
@@ -131,7 +146,8 @@ class GatherBaker(LightViewBaker):
         """Texel list at one entry per texel (re-checked once the exact count is known),
         the UV-space target of the list pass, and the view depth."""
         side = plan.max_view_side
-        return plan.settings.size**2 * (ENTRY_BYTES + 1) + side * side * (1 + 4 * views_per_dispatch(plan))
+        entries = plan.settings.size**2 * plan.settings.sample_count
+        return entries * (ENTRY_BYTES + 1) + side * side * (1 + 4 * views_per_dispatch(plan))
 
     def _allocate(self) -> None:
         plan = self.plan
@@ -150,8 +166,10 @@ class GatherBaker(LightViewBaker):
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
         # Batches of nearby directions face nearly the same normal bins (core/normal_bins.py).
         self.direction_order = proximity_order(plan.directions)
+        # Uploaded entries always hold both normals (_upload_texel_list).
+        self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self._build_texel_list()
-        self.stats = dict(view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
+        self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
                           views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0,
                           shading_normals=self.plan.smooth_shading)
@@ -164,11 +182,15 @@ class GatherBaker(LightViewBaker):
         self.hole_runs: dict[int, list[tuple[int, int]]] = {}
         if plan.holes is None:
             return None
-        self.chunks = face_chunks(np.concatenate([plan.target_positions, plan.occluder_positions]))
+        self.chunks = face_chunks(plan.drawn_positions)
         return self.chunks.order
 
-    def _target_batch(self) -> "gpu.types.GPUBatch":
-        """The target with each face's normal bin, and the cones of the bins' normals."""
+    def _target_batch(self) -> "gpu.types.GPUBatch | None":
+        """The target with each face's normal bin, and the cones of the bins' normals (None
+        when the receivers are uploaded: cpu_receivers)."""
+        self.receivers = cpu_receivers(self.plan)
+        if self.receivers is not None:
+            return None
         faces = self.plan.target_faces
         bins = normal_bins(faces[:, :3])
         # An entry weighs in wherever its shading normal faces the light: each bin's cone
@@ -186,9 +208,54 @@ class GatherBaker(LightViewBaker):
                                           len(self.chunks.order))
             self.hole_runs = dict(zip(indices, runs))
 
+    def _allocate_list(self, count: int, uploaded: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """The list textures for `count` entries (LIST_WIDTH per row) and zeroed sums;
+        uploaded: (position (count, 4), normal (count, 4)) float32 to fill them with (the
+        texel of each entry then stays on the CPU: only accumulated() reads it)."""
+        size = self.plan.settings.size
+        self.entry_count = count
+        rows = max(1, -(-count // LIST_WIDTH))
+        if rows > gpu.capabilities.max_texture_size_get():
+            raise BakeInputError(f"{count} covered texels exceed this GPU's texture limit; use a smaller map")
+        if count > size * size:  # overlapping UV islands or sub-texel samples: more entries than texels
+            util.check_texture_limits(size, self.plan.max_view_side,
+                                      count * ENTRY_BYTES + self.plan.max_view_side**2 * 8)
+        shape = (LIST_WIDTH, rows)
+        if uploaded is None:
+            self.entry_position = gpu.types.GPUTexture(shape, format='RGBA32F')
+            self.entry_normal = gpu.types.GPUTexture(shape, format='RGBA32F')
+            self.entry_texel = gpu.types.GPUTexture(shape, format='R32UI')
+        else:
+            def texture(values: np.ndarray) -> "gpu.types.GPUTexture":
+                full = np.zeros((rows * LIST_WIDTH, 4), np.float32)
+                full[:count] = values
+                return gpu.types.GPUTexture(shape, format='RGBA32F',
+                                            data=gpu.types.Buffer('FLOAT', full.size, full.ravel()))
+            self.entry_position, self.entry_normal = (texture(v) for v in uploaded)
+        self.accum = gpu.types.GPUTexture(shape, format='RG32F')
+        self.accum.clear(format='FLOAT', value=(0.0, 0.0))
+
+    def _upload_texel_list(self, receivers: Receivers) -> None:
+        """The list from CPU receivers: sorted by normal bin (of the true surface), both
+        normals octahedral-encoded (the SHADING_NORMALS layout)."""
+        receivers = receivers.subset(receivers.inv_s > 0.0)
+        bins = normal_bins(receivers.geometric)
+        order = np.argsort(bins, kind="stable")
+        bins = bins[order]
+        self.bin_axis, self.bin_threshold = bin_cones(receivers.shading[order], bins, np.ones(len(bins), bool))
+        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=BIN_COUNT))]).astype(np.int64)
+        position = np.concatenate([receivers.points[order], receivers.inv_s[order, None]], axis=1)
+        normal = np.concatenate([octahedral_coords(receivers.shading[order]),
+                                 octahedral_coords(receivers.geometric[order])], axis=1)
+        self.entry_texels = receivers.texel[order]
+        self._allocate_list(len(order), (position.astype(np.float32), normal.astype(np.float32)))
+
     def _build_texel_list(self) -> None:
         """Count the target's UV-space fragments per normal bin, allocate the list at that
-        size with each bin's entries together, fill it."""
+        size with each bin's entries together, fill it (or upload cpu_receivers)."""
+        if self.receivers is not None:
+            self._upload_texel_list(self.receivers)
+            return
         size = self.plan.settings.size
         counter = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32UI')
         uv_target = gpu.types.GPUTexture((size, size), format='R8')
@@ -214,19 +281,7 @@ class GatherBaker(LightViewBaker):
         per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
         count = int(per_bin.sum())
         self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
-        self.entry_count = count
-        rows = max(1, -(-count // LIST_WIDTH))
-        if rows > gpu.capabilities.max_texture_size_get():
-            raise BakeInputError(f"{count} covered texels exceed this GPU's texture limit; use a smaller map")
-        if count > size * size:  # overlapping UV islands: more entries than texels
-            util.check_texture_limits(size, self.plan.max_view_side,
-                                      count * ENTRY_BYTES + self.plan.max_view_side**2 * 8)
-        shape = (LIST_WIDTH, rows)
-        self.entry_position = gpu.types.GPUTexture(shape, format='RGBA32F')
-        self.entry_normal = gpu.types.GPUTexture(shape, format='RGBA32F')
-        self.entry_texel = gpu.types.GPUTexture(shape, format='R32UI')
-        self.accum = gpu.types.GPUTexture(shape, format='RG32F')
-        self.accum.clear(format='FLOAT', value=(0.0, 0.0))
+        self._allocate_list(count)
         # Only FLOAT buffers upload: the uint32 starts travel as float bits (floatBitsToUint).
         starts = self.bin_first[:-1].astype(np.uint32).view(np.float32)
         bin_start = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32F',
@@ -254,6 +309,7 @@ class GatherBaker(LightViewBaker):
         self.pending = []
         self.chunks = None
         self.entry_position = self.entry_normal = self.entry_texel = self.accum = None
+        self.receivers = self.entry_texels = None
         super()._release()
 
     def run_direction(self, index: int) -> None:
@@ -298,7 +354,7 @@ class GatherBaker(LightViewBaker):
             block["omega"][k] = (*view.omega, 0.0)
             block["view_info"][k] = (view.width, view.height, view.pixel_size / (view.depth_far - view.depth_near), 0.0)
         self.views_block.update(self.views_data.view(np.float32))
-        shader = gather_shader(self.plan.settings.weighting == "uniform", len(views), self.plan.smooth_shading)
+        shader = gather_shader(self.plan.settings.weighting == "uniform", len(views), self.shading_layout)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         for k in range(len(views)):
@@ -328,8 +384,11 @@ class GatherBaker(LightViewBaker):
         if n == 0:
             return np.zeros((size, size)), np.zeros((size, size))
         sums = util.texture_to_numpy(self.accum, np.float32).reshape(-1, 2)[:n].astype(np.float64)
-        texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
-        flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
+        if self.receivers is not None:
+            flat = self.entry_texels
+        else:
+            texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
+            flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
         num = np.bincount(flat, weights=sums[:, 0], minlength=size * size)
         den = np.bincount(flat, weights=sums[:, 1], minlength=size * size)
         return num.reshape(size, size), den.reshape(size, size)

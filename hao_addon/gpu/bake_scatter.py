@@ -24,6 +24,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.errors import BakeInputError
 from ..core.plan import BakePlan
 from . import util
 from .light_view import RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, soup_shader_info
@@ -92,6 +93,17 @@ def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
 
 class ScatterBaker(LightViewBaker):
     """Owns the accumulator and the light-view targets of one bake."""
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        """Also refuse Selected to Active: the scatter rasterizes the target's own triangles,
+        and high-poly points projected onto its texels are no triangles it could draw."""
+        if plan.projected is not None:
+            other = ("the gather (Shadow-Map Gather)" if plan.settings.max_distance == 0.0 else
+                     "the reference method, or the gather with unlimited max distance")
+            raise BakeInputError(f"the histogram scatter cannot bake Selected to Active (it draws the target's own "
+                                 f"surface); use {other}")
+        super().check_limits(plan)
 
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:

@@ -52,19 +52,21 @@ def depth_shader() -> "gpu.types.GPUShader":
 
 def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None,
                face_bins: np.ndarray | None = None) -> "gpu.types.GPUBatch":
-    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0).
+    """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)
+    (plan.drawn_positions: the occluders alone in Selected to Active).
     Attributes "face" and "above" are per corner: the shading normal and 1 / S
     (plan.target_corners) and the above-face fraction (plan.target_above).
     order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
     face normal bins, added as the float attribute "bin" with the face normal as
     "geometric" (target alone only)."""
-    ft = len(plan.target_positions)
+    # Selected to Active: the target is not drawn with the occluders (plan.target_drawn).
+    ft = len(plan.target_positions) if plan.target_drawn or not with_occluders else 0
     fo = len(plan.occluder_positions) if with_occluders else 0
-    pos = np.concatenate([plan.target_positions, plan.occluder_positions[:fo]])
-    uv = np.concatenate([plan.target_uvs, np.zeros((fo, 3, 2), np.float32)])
+    pos = np.concatenate([plan.target_positions[:ft], plan.occluder_positions[:fo]])
+    uv = np.concatenate([plan.target_uvs[:ft], np.zeros((fo, 3, 2), np.float32)])
     occ_face = np.concatenate([plan.occluder_normals[:fo], np.zeros((fo, 1), np.float32)], axis=1)
-    face = np.concatenate([plan.target_corners, np.repeat(occ_face[:, None, :], 3, axis=1)])
-    above = np.concatenate([plan.target_above, np.zeros((fo, 3), np.float32)])
+    face = np.concatenate([plan.target_corners[:ft], np.repeat(occ_face[:, None, :], 3, axis=1)])
+    above = np.concatenate([plan.target_above[:ft], np.zeros((fo, 3), np.float32)])
     assert len(pos) == ft + fo
     if order is not None:
         pos, uv, face, above = pos[order], uv[order], face[order], above[order]

@@ -1,0 +1,121 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""High-to-low projection (Cycles' Selected to Active): which point of the high-poly sources
+each texel sample of the low-poly target stands for.
+
+As Blender's bake does it (render/intern/bake.cc, RE_bake_pixels_populate_from_objects):
+- without a cage object the ray starts at the low-poly point pushed out by the cage
+  extrusion along the low-poly's normal (vertex normals interpolated on smooth faces, the
+  face normal on flat ones; custom normals play no part) and points back along -normal;
+- with a cage object (same triangles as the target) it starts at the cage's point of the
+  same barycentric coordinates and points towards the low-poly point;
+- the nearest hit of any source, front or back face, wins; with a max ray distance > 0 a
+  hit farther than that from the ray's start is a miss. A sample that misses gets no value.
+One ray per sample, once per bake (mathutils' BVH, about 2 us a ray here; the GPU passes
+then bake the hit points like any other receivers).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import BakeInputError
+from .geometry import TriangleSoup, smooth_vertex_normals
+
+
+@dataclass
+class HighToLow:
+    """A Selected-to-Active request. sources: the high-poly meshes (world space, with their
+    shading normals where they have them). extrusion_normals: (Ft, 3, 3) the direction the
+    cage extrusion pushes each target corner, in the low-poly's object space (None: Blender's
+    smooth vertex normals of the target, low_linear the identity). cage: (Ft, 3, 3) world corners of a cage object with the target's triangles, or
+    None. The cage extrusion and max ray distance are bake settings (core/settings.py)."""
+
+    sources: list[TriangleSoup]
+    extrusion_normals: np.ndarray | None = None
+    cage: np.ndarray | None = None
+    cage_name: str = "cage"
+    # The low-poly's object-to-world linear map (3, 3). Blender extrudes in object space
+    # (normalized object-space normal times the extrusion, then transformed), so on a scaled
+    # object the extrusion scales too; extrusion_normals are then object-space normals.
+    low_linear: np.ndarray | None = None
+
+
+def check_high_to_low(target: TriangleSoup, request: HighToLow) -> None:
+    """Raise BakeInputError for a request that cannot be baked."""
+    if not request.sources or not any(s.face_count for s in request.sources):
+        raise BakeInputError(f"Selected to Active needs a high-poly source with faces besides '{target.name}'")
+    for source in request.sources:
+        if not np.isfinite(source.positions).all():
+            raise BakeInputError(f"'{source.name}' has NaN or infinite vertex positions")
+    if request.cage is not None:
+        if request.cage.shape != target.positions.shape:
+            raise BakeInputError(f"the cage '{request.cage_name}' has {len(request.cage)} triangles, "
+                                 f"'{target.name}' has {target.face_count}: a cage must be a copy of the "
+                                 f"low-poly with moved vertices")
+        if not np.isfinite(request.cage).all():
+            raise BakeInputError(f"the cage '{request.cage_name}' has NaN or infinite vertex positions")
+
+
+def ray_starts(target: TriangleSoup, request: HighToLow, face: np.ndarray, bary: np.ndarray,
+               cage_extrusion: float) -> tuple[np.ndarray, np.ndarray]:
+    """(origins (m, 3), unit directions (m, 3)) world, of the samples at (face (m,), bary (m, 3))."""
+    low = np.einsum("mk,mkd->md", bary, target.positions[face])
+    if request.cage is not None:
+        origins = np.einsum("mk,mkd->md", bary, request.cage[face])
+        d = low - origins
+    else:
+        normals = request.extrusion_normals
+        linear = np.eye(3) if request.low_linear is None else np.asarray(request.low_linear, np.float64)
+        if normals is None:
+            normals = smooth_vertex_normals(target.positions)
+            linear = np.eye(3)
+        n = np.einsum("mk,mkd->md", bary, normals[face])
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+        origins = low + (n @ linear.T) * cage_extrusion
+        # Normals map to world space with the inverse transpose.
+        d = -(n @ np.linalg.inv(linear)) if abs(np.linalg.det(linear)) > 1e-300 else -(n @ linear.T)
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    return origins, np.divide(d, length, out=np.zeros_like(d), where=length > 0.0)
+
+
+def project(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, max_ray_distance: float
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """First hit of each ray on triangles (Fs, 3, 3) (both sides). Returns (face (m,) int64,
+    -1 for a miss or a zero direction; bary (m, 3) float64 of the hit point on that face)."""
+    from mathutils.bvhtree import BVHTree  # numpy core otherwise; mathutils comes with bpy
+
+    verts = triangles.reshape(-1, 3).tolist()
+    bvh = BVHTree.FromPolygons(verts, np.arange(len(verts)).reshape(-1, 3).tolist(), all_triangles=True, epsilon=0.0)
+    reach = max_ray_distance if max_ray_distance > 0.0 else 1e30
+    ray_cast = bvh.ray_cast
+    face = np.full(len(origins), -1, np.int64)
+    points = np.zeros((len(origins), 3))
+    usable = np.flatnonzero(np.abs(directions).sum(axis=1) > 0.0)
+    for i, o, d in zip(usable.tolist(), origins[usable].tolist(), directions[usable].tolist()):
+        loc, _n, idx, _dist = ray_cast(o, d, reach)
+        if idx is not None:
+            face[i] = idx
+            points[i] = loc
+    hit = face >= 0
+    bary = np.zeros((len(origins), 3))
+    bary[hit] = barycentric(points[hit], triangles[face[hit]])
+    return face, bary
+
+
+def barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(m, 3) barycentric coordinates of points (m, 3) in triangles (m, 3, 3), clipped to the
+    triangle (the BVH's float32 hit can lie a hair outside)."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2, p = b - a, c - a, points - a
+    d11 = np.einsum("md,md->m", e1, e1)
+    d12 = np.einsum("md,md->m", e1, e2)
+    d22 = np.einsum("md,md->m", e2, e2)
+    p1 = np.einsum("md,md->m", p, e1)
+    p2 = np.einsum("md,md->m", p, e2)
+    det = d11 * d22 - d12 * d12
+    safe = np.where(np.abs(det) > 0.0, det, 1.0)
+    v = (d22 * p1 - d12 * p2) / safe
+    w = (d11 * p2 - d12 * p1) / safe
+    out = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
+    return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-30)

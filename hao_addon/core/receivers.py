@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Receivers: the surface points a bake estimates AO at, each with the texel it adds to.
+
+A map's value at a texel is the ratio of its receivers' summed (V w, w) terms (core/plan.py,
+_shading_corners), so one bake design serves every kind of receiver:
+- the texel centres of the target's UV layout (what the gather's GPU texel list holds),
+- stratified sub-texel points of it (anti-aliasing, samples_per_texel > 1),
+- points on high-poly sources that the low-poly's texels project to (core/projection.py).
+The gather uploads a Receivers list as its texel list; the reference baker traces from it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .normalization import hemisphere_weight
+from .uv_raster import texel_surface_samples
+
+
+@dataclass
+class Receivers:
+    """points: (n, 3) float64 normalized positions; geometric: (n, 3) unit normals of the true
+    surface (rays start off it, directions below it are occluded); shading: (n, 3) unit
+    normals the hemisphere and the cosine weight are about; inv_s: (n,) 1 / S, S the exact
+    normalizer of the shading normal (0: never lit, the receiver adds nothing); texel: (n,)
+    int64 flat texel index y * size + x."""
+
+    points: np.ndarray
+    geometric: np.ndarray
+    shading: np.ndarray
+    inv_s: np.ndarray
+    texel: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def subset(self, keep: np.ndarray) -> "Receivers":
+        return Receivers(self.points[keep], self.geometric[keep], self.shading[keep], self.inv_s[keep],
+                         self.texel[keep])
+
+
+def sub_texel_grid(samples_per_texel: int) -> int:
+    """Points per texel side: 1, 2, 3 or 4 for 1, 4, 9 or 16 samples per texel."""
+    side = math.isqrt(samples_per_texel)
+    if side * side != samples_per_texel or side < 1:
+        raise ValueError(f"samples per texel must be a square (1, 4, 9, 16), got {samples_per_texel}")
+    return side
+
+
+def texel_sample_points(uvs: np.ndarray, size: int, samples_per_texel: int = 1
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stratified points of every texel a UV triangle covers: the centres of a k x k grid
+    inside the texel (k^2 = samples_per_texel; k = 1 is the texel centre).
+
+    uvs: (F, 3, 2). Returns (texel (m,) int64 flat index y * size + x, face (m,) int64,
+    bary (m, 3) float64) for the points inside some triangle (the first one, where UV
+    islands overlap)."""
+    k = sub_texel_grid(samples_per_texel)
+    face, bary, _hits = texel_surface_samples(np.asarray(uvs, np.float64), size * k)
+    ys, xs = np.nonzero(face >= 0)
+    texel = (ys // k) * size + xs // k
+    return texel.astype(np.int64), face[ys, xs], bary[ys, xs]
+
+
+def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """(m, 3) unit vectors: corners (F, 3, 3) interpolated at (face (m,), bary (m, 3))."""
+    v = np.einsum("mk,mkd->md", bary, corners[face].astype(np.float64))
+    return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
+
+
+def exact_inverse_normalizers(shading: np.ndarray, directions: np.ndarray, weighting: str,
+                              chunk: int = 16384) -> np.ndarray:
+    """(n,) 1 / S for unit shading normals (n, 3): S = sum_d weight(omega_d . n), 0 where no
+    direction lights the normal."""
+    dirs_t = np.ascontiguousarray(np.asarray(directions, np.float32).T)
+    ones = np.ones(dirs_t.shape[1], np.float32)
+    s = np.empty(len(shading))
+    normals = np.asarray(shading, np.float32)
+    for start in range(0, len(shading), chunk):
+        s[start:start + chunk] = hemisphere_weight(normals[start:start + chunk] @ dirs_t, weighting) @ ones
+    return np.divide(1.0, s, out=np.zeros_like(s), where=s > 0.0)
+
+
+def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corners: np.ndarray, size: int,
+                 samples_per_texel: int = 1) -> Receivers:
+    """The target's own surface at the sample points of its UV layout (BakePlan fields:
+    positions (F, 3, 3) normalized, uvs (F, 3, 2), faces (F, 4) normal and 1 / S_f, corners
+    (F, 3, 4) shading normal and 1 / S). Faces never lit are left out. 1 / S is interpolated
+    like the GPU passes interpolate it."""
+    texel, face, bary = texel_sample_points(uvs, size, samples_per_texel)
+    lit = faces[face, 3] > 0.0
+    texel, face, bary = texel[lit], face[lit], bary[lit]
+    points = np.einsum("mk,mkd->md", bary, positions[face].astype(np.float64))
+    shading = interpolate_unit(corners[..., :3], face, bary)
+    inv_s = np.einsum("mk,mk->m", bary, corners[face, :, 3].astype(np.float64))
+    return Receivers(points, faces[face, :3].astype(np.float64), shading, inv_s, texel)
