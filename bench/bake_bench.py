@@ -14,6 +14,11 @@ cosine-weighted, unlimited-distance accessibility on face normals. A triangle-co
 once untimed first (shader compilation; Cycles' first-bake set-up), then every timed run is
 one bake as a user would run it. Both bakers run with margin 0 (no island growth; the error is
 measured inside the islands).
+Smooth rows: the same meshes and layouts shaded smooth (Blender's corner normals), HAO and
+Cycles at lower sample counts against Cycles' own smooth bake at 1024 samples (all interior
+texels). High-to-low row: the bunny baked onto a 2 % Decimate copy of itself (xatlas UVs,
+cage extrusion 0.005, max ray distance 0.02), HAO's gather against Cycles' Selected to
+Active at 1024 samples. --parts picks the row groups.
 Writes bake_bench.json and bake_bench.png into the output folder.
 """
 from __future__ import annotations
@@ -40,6 +45,9 @@ from hao_addon.core.settings import BakeSettings  # noqa: E402
 from hao_addon.core.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
 from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "tools"))
+from cycles_bake import cycles_ao_bake  # noqa: E402
+
 MESHES = {"rocker-arm": ROOT / "tests" / "data" / "rocker-arm.obj",
           "bunny": ROOT / "bench" / "data" / "stanford-bunny.obj"}
 
@@ -64,73 +72,129 @@ def errors(ao, ys, xs, ref):
     return dict(rmse=float(np.sqrt((e * e).mean())), p99=float(np.percentile(np.abs(e), 99)), bias=float(e.mean()))
 
 
-def mesh_object(soup, name):
+def mesh_object(soup, name, smooth: bool = False, uvs: bool = True):
     pos = soup.positions.reshape(-1, 3)
     verts, inverse = np.unique(pos, axis=0, return_inverse=True)
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(verts.tolist(), [], inverse.reshape(-1, 3).tolist())
-    layer = mesh.uv_layers.new(name="UVMap")
-    layer.uv.foreach_set("vector", soup.uvs.reshape(-1).astype(np.float32))
+    if uvs:
+        layer = mesh.uv_layers.new(name="UVMap")
+        layer.uv.foreach_set("vector", soup.uvs.reshape(-1).astype(np.float32))
     for p in mesh.polygons:
-        p.use_smooth = False  # Cycles then shades with face normals, as HAO does
+        p.use_smooth = smooth  # flat: Cycles then shades with face normals, as HAO's flat rows do
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
 
 
 def cycles_bake(soup, size, samples_list):
-    """Cycles' own AO bake (CPU) of the same UV layout; returns [(samples, seconds, ao)]."""
+    """Cycles' own AO bake (CPU, flat shading) of the same UV layout; returns [(samples, seconds, ao)]."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     obj = mesh_object(soup, "Target")
-    img = bpy.data.images.new("cycles_ao", size, size, float_buffer=True)
-    img.colorspace_settings.name = 'Non-Color'
-    mat = bpy.data.materials.new("bake")
-    if mat.node_tree is None:
-        mat.use_nodes = True
-    tex = mat.node_tree.nodes.new('ShaderNodeTexImage')
-    tex.image = img
-    mat.node_tree.nodes.active = tex
-    obj.data.materials.append(mat)
-    scene = bpy.context.scene
-    scene.render.engine = 'CYCLES'
-    scene.cycles.device = 'CPU'
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False  # samples mean samples (the default stops near RMSE 0.015)
-    scene.world = bpy.data.worlds.new("bench")
-    scene.world.light_settings.distance = 1e6  # "unlimited", matching HAO's max distance 0
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    out = []
     # Warm-up (not timed), as for HAO: the first bake of a session pays one-off set-up.
-    scene.cycles.samples = 1
-    bpy.ops.object.bake(type='AO', use_clear=True, margin=0)
-    for spp in samples_list:
-        scene.cycles.samples = spp
-        t = time.perf_counter()
-        bpy.ops.object.bake(type='AO', use_clear=True, margin=0)
-        dt = time.perf_counter() - t
-        px = np.empty(size * size * 4, np.float32)
-        img.pixels.foreach_get(px)
-        out.append((spp, dt, px.reshape(size, size, 4)[..., 0].copy()))
-        print(f"  cycles {spp:5d} spp: {dt:7.2f} s", flush=True)
-    return out
+    return cycles_ao_bake(obj, size, samples_list, warm_up=True, log=True)
 
 
-def hao_runs(soup, size, method, directions_list, view_samples=2.0):
+def hao_runs(soup, size, method, directions_list, view_samples=2.0, high_to_low=None, **settings):
     out = []
     # Warm-up (not timed): shader compilation (LLVM JIT, ~0.1 s per variant) happens once per
     # session, and Cycles gets the same courtesy in cycles_bake.
-    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0),
-         use_cache=False)
+    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0, **settings),
+         use_cache=False, high_to_low=high_to_low)
     for d in directions_list:
         t = time.perf_counter()
         # margin=0 as in cycles_bake: neither grows islands (error is measured inside them).
         res = bake(soup, [], BakeSettings(size=size, directions=d, method=method, view_samples=view_samples,
-                                          margin=0), use_cache=False)
+                                          margin=0, **settings), use_cache=False, high_to_low=high_to_low)
         dt = time.perf_counter() - t
         out.append((d, dt, res.ao))
         print(f"  {method:7s} {d:5d} dirs: {dt:7.2f} s", flush=True)
     return out
+
+
+def truth_errors(ao, truth, mask):
+    """RMSE, p99 and bias of ao against a Cycles truth over the mask (2-ring interior texels
+    both bakes cover)."""
+    e = ao[mask].astype(np.float64) - truth[mask]
+    return dict(rmse=float(np.sqrt((e * e).mean())), p99=float(np.percentile(np.abs(e), 99)), bias=float(e.mean()))
+
+
+def smooth_rows(soup, size, dirs, spp, truth_spp):
+    """The mesh shaded smooth (Blender's corner normals), HAO's two bakers and Cycles at lower
+    sample counts (seed 1) against Cycles' smooth bake at truth_spp (seed 0)."""
+    from hao_addon.blender import mesh_data
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    obj = mesh_object(soup, "Smooth", smooth=True)
+    smooth = mesh_data.evaluated_soup(obj, bpy.context.evaluated_depsgraph_get(), "UVMap")
+    (_, truth_s, truth), = cycles_ao_bake(obj, size, [truth_spp], seed=0, warm_up=True, log=True)
+    face, _bary, hits = texel_surface_samples(soup.uvs, size)
+    mask = interior_mask(face, hits) & (truth > 0)
+    runs = {"scatter": [], "gather": [], "cycles": []}
+    for s, dt, ao in cycles_ao_bake(obj, size, spp, seed=1, log=True):
+        runs["cycles"].append(dict(samples=s, seconds=dt, **truth_errors(ao, truth, mask)))
+    for method in ("scatter", "gather"):
+        for d, dt, ao in hao_runs(smooth, size, method, dirs):
+            runs[method].append(dict(directions=d, seconds=dt, **truth_errors(ao, truth, mask)))
+    return dict(triangles=soup.face_count, size=size, truth=dict(samples=truth_spp, seconds=truth_s),
+                smooth_corners=int((np.abs(smooth.normals - face_normals_areas(smooth.positions)[0][:, None]).sum(-1)
+                                    > 1e-6).sum()), interior_texels=int(mask.sum()), runs=runs)
+
+
+# The high-to-low pair: the bunny onto a 2 % Decimate copy, unwrapped by xatlas, both shaded
+# smooth (as tests/shading_scenes.HIGH_TO_LOW, at the benchmark's size).
+PAIR_RATIO, PAIR_EXTRUSION, PAIR_MAX_RAY = 0.02, 0.005, 0.02
+
+
+def high_to_low_rows(size, dirs, spp, truth_spp):
+    """Selected to Active of the bunny pair: HAO's gather (the scatter cannot bake it) and
+    Cycles at lower sample counts (seed 1) against Cycles' Selected-to-Active bake at truth_spp."""
+    from hao_addon.bake import HighToLow
+    from hao_addon.blender import mesh_data
+    from hao_addon.core.objfile import read_obj
+    from hao_addon.core.unwrap import xatlas_unwrap
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    v, t, _uv, _tu = read_obj(MESHES["bunny"])
+    high = mesh_object(_soup(v, t), "High", smooth=True, uvs=False)
+    modifier = high.modifiers.new("decimate", 'DECIMATE')
+    modifier.ratio = PAIR_RATIO
+    dg = bpy.context.evaluated_depsgraph_get()
+    low_mesh = high.evaluated_get(dg).to_mesh()
+    low_mesh.calc_loop_triangles()
+    lv = np.array([x.co[:] for x in low_mesh.vertices])
+    lt = np.array([tri.vertices[:] for tri in low_mesh.loop_triangles])
+    high.modifiers.remove(modifier)
+    t0 = time.perf_counter()
+    low_soup = _soup(lv, lt, xatlas_unwrap(lv, lt, size))
+    unwrap_s = time.perf_counter() - t0
+    low = mesh_object(low_soup, "Low", smooth=True)
+    dg = bpy.context.evaluated_depsgraph_get()
+    target = mesh_data.evaluated_soup(low, dg, "UVMap")
+    source = mesh_data.evaluated_soup(high, dg, None)
+    normals, linear = mesh_data.extrusion_normals(low, dg)
+    request = HighToLow([source], normals, low_linear=linear)
+    (_, truth_s, truth), = cycles_ao_bake(low, size, [truth_spp], seed=0, sources=(high,), cage_extrusion=PAIR_EXTRUSION,
+                                          max_ray_distance=PAIR_MAX_RAY, warm_up=True, log=True)
+    face, _bary, hits = texel_surface_samples(low_soup.uvs, size)
+    runs = {"gather": [], "cycles": []}
+    for s, dt, ao in cycles_ao_bake(low, size, spp, seed=1, sources=(high,), cage_extrusion=PAIR_EXTRUSION,
+                                    max_ray_distance=PAIR_MAX_RAY, log=True):
+        runs["cycles"].append(dict(samples=s, seconds=dt, ao=ao))
+    gather = hao_runs(target, size, "gather", dirs, high_to_low=request, cage_extrusion=PAIR_EXTRUSION,
+                      max_ray_distance=PAIR_MAX_RAY)
+    mask = interior_mask(face, hits) & (truth > 0) & (gather[-1][2] > 0)  # texels both bakes found
+    for r in runs["cycles"]:
+        r.update(truth_errors(r.pop("ao"), truth, mask))
+    for d, dt, ao in gather:
+        runs["gather"].append(dict(directions=d, seconds=dt, **truth_errors(ao, truth, mask)))
+    return dict(triangles=int(len(t)), low_triangles=int(len(lt)), size=size, xatlas_seconds=unwrap_s,
+                truth=dict(samples=truth_spp, seconds=truth_s), interior_texels=int(mask.sum()), runs=runs)
+
+
+def _soup(v, t, uvs=None):
+    from hao_addon.core.geometry import TriangleSoup
+    return TriangleSoup(np.asarray(v, np.float64)[t], uvs)
 
 
 def triangle_sweep(quick):
@@ -152,37 +216,51 @@ def triangle_sweep(quick):
 
 
 def plot(results, path):
+    """One time-against-error panel per row group and mesh (flat against the ray-traced
+    reference, smooth and high-to-low against Cycles' own bake at high samples), plus the
+    triangle sweep."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    names = list(results["meshes"])
-    fig, axes = plt.subplots(1, len(names) + 1, figsize=(6 * (len(names) + 1), 4.8))
+    panels = [(f"{name} (flat)", m, "interior RMSE vs 1024-ray reference") for name, m in results.get("meshes", {}).items()]
+    for group, label in (("smooth", "smooth"), ("high_to_low", "Selected to Active")):
+        for name, m in results.get(group, {}).items():
+            panels.append((f"{name} ({label})", m, f"interior RMSE vs Cycles {m['truth']['samples']} spp"))
+    sweep = results.get("triangle_sweep")
+    count = len(panels) + (1 if sweep else 0)
+    cols = min(count, 3)
+    rows = -(-count // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(6 * cols, 4.8 * rows), squeeze=False)
+    axes = axes.ravel()
     styles = {"scatter": ("o-", "HAO scatter (McGraw & Sowers)"), "gather": ("s-", "HAO shadow-map gather"),
               "cycles": ("^-", "Cycles AO bake (CPU)")}
-    for ax, name in zip(axes, names):
-        m = results["meshes"][name]
+    for ax, (title, m, ylabel) in zip(axes, panels):
         for key, (style, label) in styles.items():
-            runs = m["runs"][key]
+            runs = m["runs"].get(key)
+            if not runs:
+                continue
             ax.loglog([r["seconds"] for r in runs], [r["rmse"] for r in runs], style, label=label)
             for r in runs:
                 ax.annotate(str(r.get("directions", r.get("samples"))), (r["seconds"], r["rmse"]), fontsize=7,
                             textcoords="offset points", xytext=(3, 3))
         ax.axhline(0.02, color="gray", lw=0.8, ls="--")
-        ax.set_title(f"{name}: {m['triangles']:,} tris, {m['size']}x{m['size']}")
+        ax.set_title(f"{title}: {m['triangles']:,} tris, {m['size']}x{m['size']}")
         ax.set_xlabel("wall time (s), 2-core CPU, llvmpipe")
-        ax.set_ylabel("interior RMSE vs 1024-ray reference")
+        ax.set_ylabel(ylabel)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    ax = axes[-1]
-    sw = results["triangle_sweep"]
-    ax.loglog([r["triangles"] for r in sw], [r["ms_per_direction"] for r in sw], "o-", label="measured")
-    t0, c0 = sw[0]["triangles"], sw[0]["ms_per_direction"]
-    ax.loglog([r["triangles"] for r in sw], [c0 * r["triangles"] / t0 for r in sw], "k:", label="linear")
-    ax.set_xlabel("triangles")
-    ax.set_ylabel("ms per direction (1024^2)")
-    ax.set_title("cost against triangle count")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    if sweep:
+        ax = axes[len(panels)]
+        ax.loglog([r["triangles"] for r in sweep], [r["ms_per_direction"] for r in sweep], "o-", label="measured")
+        t0, c0 = sweep[0]["triangles"], sweep[0]["ms_per_direction"]
+        ax.loglog([r["triangles"] for r in sweep], [c0 * r["triangles"] / t0 for r in sweep], "k:", label="linear")
+        ax.set_xlabel("triangles")
+        ax.set_ylabel("ms per direction (1024^2)")
+        ax.set_title("cost against triangle count")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    for ax in axes[count:]:
+        ax.axis("off")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -192,6 +270,7 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true", help="small sweep (smoke test, minutes)")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
     ap.add_argument("--meshes", default="rocker-arm,bunny")
+    ap.add_argument("--parts", default="flat,smooth,high-to-low", help="row groups to run (comma-separated)")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -204,7 +283,9 @@ def main() -> int:
                                 blender=bpy.app.version_string, gpu=_gpu_name()),
                    settings=dict(size=size, reference_texels=ref_texels, reference_rays=ref_rays, view_samples=2.0),
                    meshes={})
-    for name in args.meshes.split(","):
+    parts = args.parts.split(",")
+    truth_spp = 256 if args.quick else 1024
+    for name in args.meshes.split(",") if "flat" in parts else []:
         print(f"{name}:", flush=True)
         t = time.perf_counter()
         soup = obj_soup(MESHES[name], uvs="xatlas", size=size)
@@ -220,8 +301,18 @@ def main() -> int:
         results["meshes"][name] = dict(triangles=soup.face_count, size=size, xatlas_seconds=unwrap_s,
                                        reference_seconds=ref_s, interior_texels=interior, runs=runs)
         (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
-    print("triangle sweep:", flush=True)
-    results["triangle_sweep"] = triangle_sweep(args.quick)
+    for name in args.meshes.split(",") if "smooth" in parts else []:
+        print(f"{name}, shaded smooth:", flush=True)
+        soup = obj_soup(MESHES[name], uvs="xatlas", size=size)
+        results.setdefault("smooth", {})[name] = smooth_rows(soup, size, dirs, spp[:-1] or spp, truth_spp)
+        (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
+    if "high-to-low" in parts:
+        print("bunny pair, Selected to Active:", flush=True)
+        results["high_to_low"] = {"bunny": high_to_low_rows(size, dirs, spp[:-1] or spp, truth_spp)}
+        (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
+    if "flat" in parts:
+        print("triangle sweep:", flush=True)
+        results["triangle_sweep"] = triangle_sweep(args.quick)
     (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
     plot(results, out / "bake_bench.png")
     print(f"wrote {out / 'bake_bench.json'} and {out / 'bake_bench.png'}")

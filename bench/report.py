@@ -89,7 +89,7 @@ def main() -> int:
         print(spheres_tables(res))
         return 0
     lines = []
-    for name, m in res["meshes"].items():
+    for name, m in res.get("meshes", {}).items():
         lines.append(f"**{name}** ({m['triangles']:,} triangles, {m['size']}x{m['size']}; xatlas "
                      f"{m['xatlas_seconds']:.1f} s, not included below)\n")
         lines.append("| method | directions / samples | time (s) | RMSE | p99 | bias |")
@@ -108,6 +108,32 @@ def main() -> int:
                 cells.append("outside measured range" if t is None else f"{t:.2f} s ({r['seconds'] / t:.1f}x faster)")
             lines.append(f"| {r['samples']} | {r['rmse']:.4f} | {r['seconds']:.2f} | {cells[0]} | {cells[1]} |")
         lines.append("")
+    for group, label in (("smooth", "shaded smooth"), ("high_to_low", "Selected to Active")):
+        for name, m in res.get(group, {}).items():
+            methods = [k for k in ("scatter", "gather") if m["runs"].get(k)]
+            extra = (f", onto a {m['low_triangles']:,}-triangle Decimate copy" if "low_triangles" in m else "")
+            lines.append(f"**{name}, {label}** ({m['triangles']:,} triangles{extra}, {m['size']}x{m['size']}; against "
+                         f"Cycles' own bake at {m['truth']['samples']} samples ({m['truth']['seconds']:.0f} s), "
+                         f"{m['interior_texels']:,} interior texels)\n")
+            lines.append("| method | directions / samples | time (s) | RMSE | p99 | bias |")
+            lines.append("|---|---:|---:|---:|---:|---:|")
+            for key in (*methods, "cycles"):
+                label_m = {"scatter": "HAO scatter", "gather": "HAO gather", "cycles": "Cycles CPU"}[key]
+                for r in m["runs"][key]:
+                    n = r.get("directions", r.get("samples"))
+                    lines.append(f"| {label_m} | {n} | {r['seconds']:.2f} | {r['rmse']:.4f} | {r['p99']:.4f} | "
+                                 f"{r['bias']:+.4f} |")
+            lines.append("")
+            lines.append("| Cycles samples | Cycles RMSE | Cycles time (s) | " +
+                         " | ".join(f"HAO {k}, same RMSE" for k in methods) + " |")
+            lines.append("|---:|---:|---:|" + "---:|" * len(methods))
+            for r in m["runs"]["cycles"]:
+                cells = []
+                for key in methods:
+                    t = time_at_rmse(m["runs"][key], r["rmse"])
+                    cells.append("outside measured range" if t is None else f"{t:.2f} s ({r['seconds'] / t:.1f}x faster)")
+                lines.append(f"| {r['samples']} | {r['rmse']:.4f} | {r['seconds']:.2f} | " + " | ".join(cells) + " |")
+            lines.append("")
     sw = res.get("triangle_sweep")
     if sw:
         lines.append("Cost against triangle count (default method, i.e. the gather at unlimited distance; 1024x1024, 64 directions, UV spheres over a plane):\n")

@@ -18,45 +18,19 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tools")]
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import shading_scenes as cases  # noqa: E402
+from cycles_bake import cycles_ao_bake  # noqa: E402
 
 
-def cycles_ao(obj: bpy.types.Object, size: int, samples: int, seed: int = 0,
-              sources: list | None = None, cage_extrusion: float = 0.0, max_ray_distance: float = 0.0) -> np.ndarray:
-    """Cycles' AO bake of obj; with sources, Selected to Active from them."""
-    img = bpy.data.images.new(f"truth{seed}", size, size, float_buffer=True)
-    img.colorspace_settings.name = 'Non-Color'
-    mat = bpy.data.materials.new("bake")
-    if mat.node_tree is None:
-        mat.use_nodes = True
-    tex = mat.node_tree.nodes.new('ShaderNodeTexImage')
-    tex.image = img
-    mat.node_tree.nodes.active = tex
-    obj.data.materials.clear()
-    obj.data.materials.append(mat)
-    scene = bpy.context.scene
-    scene.render.engine = 'CYCLES'
-    scene.cycles.device = 'CPU'
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.samples = samples
-    scene.cycles.seed = seed
-    scene.world = bpy.data.worlds.new("truth")
-    scene.world.light_settings.distance = 1e6
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    for source in sources or ():
-        source.select_set(True)
-    bpy.ops.object.bake(type='AO', use_clear=True, margin=0, use_selected_to_active=bool(sources),
-                        cage_extrusion=cage_extrusion, max_ray_distance=max_ray_distance)
-    px = np.empty(size * size * 4, np.float32)
-    img.pixels.foreach_get(px)
-    return px.reshape(size, size, 4)[..., 0].copy()
+def cycles_ao(obj: bpy.types.Object, size: int, samples: int, seed: int = 0, sources: tuple = (),
+              cage_extrusion: float = 0.0, max_ray_distance: float = 0.0) -> np.ndarray:
+    """Cycles' AO bake of obj (tools/cycles_bake.py); with sources, Selected to Active."""
+    return cycles_ao_bake(obj, size, [samples], seed, sources, cage_extrusion, max_ray_distance)[0][2]
 
 
 def high_to_low_truth(name: str) -> None:
@@ -66,7 +40,7 @@ def high_to_low_truth(name: str) -> None:
     low_obj, high = cases.build_high_to_low(name, low)
     _path, _ratio, extrusion, max_ray = cases.HIGH_TO_LOW[name]
     t = time.perf_counter()
-    runs = [cycles_ao(low_obj, cases.TRUTH_SIZE, cases.TRUTH_SPP, seed, [high], extrusion, max_ray) for seed in (0, 1)]
+    runs = [cycles_ao(low_obj, cases.TRUTH_SIZE, cases.TRUTH_SPP, seed, (high,), extrusion, max_ray) for seed in (0, 1)]
     np.savez_compressed(cases.truth_path(name), ao=runs[0].astype(np.float16), ao_seed1=runs[1].astype(np.float16),
                         uvs=low[2].astype(np.float32), low_vertices=low[0],
                         low_triangles=low[1].astype(np.int32), samples=cases.TRUTH_SPP, blender=bpy.app.version_string)
