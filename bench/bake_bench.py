@@ -41,8 +41,8 @@ from hao_addon.core import scenes  # noqa: E402
 from hao_addon.core.geometry import face_normals_areas  # noqa: E402
 from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
-from hao_addon.core.settings import BakeSettings  # noqa: E402
-from hao_addon.core.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
+from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
+from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
 from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tools"))
@@ -152,7 +152,7 @@ def high_to_low_rows(size, dirs, spp, truth_spp):
     from hao_addon.bake import HighToLow
     from hao_addon.blender import mesh_data
     from hao_addon.core.objfile import read_obj
-    from hao_addon.core.unwrap import xatlas_unwrap
+    from hao_addon.core.bake.unwrap import xatlas_unwrap
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     v, t, _uv, _tu = read_obj(MESHES["bunny"])

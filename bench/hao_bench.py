@@ -34,8 +34,8 @@ from hao_addon.core import scenes  # noqa: E402
 from hao_addon.core.geometry import TriangleSoup  # noqa: E402
 from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
-from hao_addon.core.view_scene import object_from_soup  # noqa: E402
-from hao_addon.core.view_settings import ViewAOSettings  # noqa: E402
+from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
+from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
 from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600

@@ -34,10 +34,10 @@ import numpy as np  # noqa: E402
 
 from hao_addon.core import camera_math as cm  # noqa: E402
 from hao_addon.core import scenes  # noqa: E402
-from hao_addon.core.lloyd import lloyd_clusters, sphere_proxies, vertex_areas  # noqa: E402
+from hao_addon.core.proxies.lloyd import lloyd_clusters, sphere_proxies, vertex_areas  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
-from hao_addon.core.view_scene import object_from_soup  # noqa: E402
-from hao_addon.core.view_settings import ViewAOSettings  # noqa: E402
+from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
+from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
 from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600

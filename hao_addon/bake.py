@@ -17,10 +17,10 @@ import numpy as np
 
 from .core.geometry import TriangleSoup
 from .core.errors import BakeInputError
-from .core.plan import make_plan
-from .core.projection import HighToLow
-from .core.seams import finalize_map
-from .core.settings import BakeSettings
+from .core.bake.plan import make_plan
+from .core.bake.projection import HighToLow
+from .core.bake.seams import finalize_map
+from .core.bake.settings import BakeSettings
 
 
 @dataclass

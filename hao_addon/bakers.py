@@ -11,7 +11,7 @@ def baker_for(method: str):
     """The bake pass class for 'scatter', 'gather' (GPU) or 'reference' (CPU ray tracing)."""
     if method == "reference":
         import bpy  # noqa: F401 - the bpy module makes mathutils (the reference's BVH) importable
-        from .core.reference_baker import ReferenceBaker
+        from .core.bake.reference_baker import ReferenceBaker
         return ReferenceBaker
     if method not in BAKE_METHODS:
         raise ValueError(f"unknown bake method '{method}', expected one of {BAKE_METHODS}")

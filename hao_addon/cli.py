@@ -41,8 +41,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .core.settings import BakeSettings
-    from .core.view_settings import RenderSize, ViewAOSettings
+    from .core.bake.settings import BakeSettings
+    from .core.hao.view_settings import RenderSize, ViewAOSettings
 
     parser = _Parser(prog="hao", description="GPU ambient occlusion for Blender scenes and meshes.")
     parser.add_argument("--version", action="version", version=f"hao {__version__}")
@@ -221,7 +221,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     from .blender.bake_job import BakeJob, BakeRequest, output_path_for
     from .blender.paths import OBJECT_TOKEN
     from .core.imageio import check_writable
-    from .core.settings import BakeSettings
+    from .core.bake.settings import BakeSettings
 
     settings = _validated(settings_from_args(args, BakeSettings), BakeSettings)
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
@@ -282,7 +282,7 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     import bpy
 
     from .core.imageio import check_writable, write_ao_file
-    from .core.view_settings import RenderSize, ViewAOSettings
+    from .core.hao.view_settings import RenderSize, ViewAOSettings
     from .render_ao import render_camera_ao
 
     size = _validated(settings_from_args(args, RenderSize), RenderSize)

@@ -9,7 +9,7 @@ import numpy as np
 from .blender.sphere_proxies import scene_spheres
 from .blender.view_scene import camera_view_projection, visible_scene_objects
 from .core.errors import BakeInputError
-from .core.view_settings import RenderSize, ViewAOSettings, render_gpu_bytes
+from .core.hao.view_settings import RenderSize, ViewAOSettings, render_gpu_bytes
 
 
 def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: int, height: int,

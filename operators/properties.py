@@ -6,7 +6,7 @@ from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringPropert
 
 from ..hao_addon import compat
 from ..hao_addon.blender.bake_job import BakeRequest
-from ..hao_addon.core.settings import BakeSettings
+from ..hao_addon.core.bake.settings import BakeSettings
 from .setting_props import setting_annotations, settings_from
 
 

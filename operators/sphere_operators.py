@@ -31,7 +31,7 @@ class OBJECT_OT_hao_sync_spheres(bpy.types.Operator):
 
     def execute(self, context):
         from ..hao_addon.blender.sphere_proxies import make_proxies
-        from ..hao_addon.core.lloyd import ProxyError
+        from ..hao_addon.core.proxies.lloyd import ProxyError
         obj = context.active_object
         try:
             info = make_proxies(obj, self.count, self.seed, self.max_iterations)
@@ -99,7 +99,7 @@ def sync_on_frame_change(scene, depsgraph=None) -> None:
     others are reused, see hao_addon/blender/sphere_proxies.py). Errors (a topology change)
     are left to the passes that use the spheres, which report them."""
     from ..hao_addon.blender.sphere_proxies import scene_spheres
-    from ..hao_addon.core.lloyd import ProxyError
+    from ..hao_addon.core.proxies.lloyd import ProxyError
     view_layer = bpy.context.view_layer
     if view_layer is None:
         return

@@ -4,7 +4,7 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty, PointerProperty
 
-from ..hao_addon.core.view_settings import ViewAOSettings
+from ..hao_addon.core.hao.view_settings import ViewAOSettings
 from .setting_props import setting_annotations, settings_from
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hao_addon.core.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 
 
 def sigma(directions: int) -> float:

@@ -49,7 +49,7 @@ def corner_uvs(name: str, size: int = TRUTH_SIZE) -> np.ndarray:
         return uv[tu]
     if truth_path(name).exists():
         return np.load(truth_path(name))["uvs"].astype(np.float64)
-    from hao_addon.core.unwrap import xatlas_unwrap
+    from hao_addon.core.bake.unwrap import xatlas_unwrap
     return xatlas_unwrap(v, t, size)
 
 
@@ -114,7 +114,7 @@ def _smooth_object(name: str, vertices: np.ndarray, triangles: np.ndarray, uvs: 
 def decimated_low_poly(name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertices (V, 3), triangles (F, 3), corner UVs (F, 3, 2)) of the case's low-poly: the
     high-poly through Blender's Decimate (collapse) at the case's ratio, unwrapped by xatlas."""
-    from hao_addon.core.unwrap import xatlas_unwrap
+    from hao_addon.core.bake.unwrap import xatlas_unwrap
     path, ratio, _e, _d = HIGH_TO_LOW[name]
     v, t, _uv, _tu = read_obj(path)
     obj = _smooth_object("decimate", v, t)

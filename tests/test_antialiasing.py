@@ -14,8 +14,8 @@ import pytest
 from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.receivers import sub_texel_grid, texel_sample_points
-from hao_addon.core.settings import BakeSettings
+from hao_addon.core.bake.receivers import sub_texel_grid, texel_sample_points
+from hao_addon.core.bake.settings import BakeSettings
 
 SIZE = 48
 DIRECTIONS = 64
@@ -138,7 +138,7 @@ def test_the_scatter_takes_more_light_view_pixels_per_texel(truth):
 
 def test_the_uploaded_texel_list_equals_the_gpu_raster(gpu_context, monkeypatch):
     """At one sample per texel the gather lists texel centres with a UV-space raster on the
-    GPU; the uploaded list (core/receivers.py) holds the same receivers."""
+    GPU; the uploaded list (core/bake/receivers.py) holds the same receivers."""
     import hao_addon.gpu.bake_gather as gather
 
     _floor, gpu_list = bake_floor("gather", "1")

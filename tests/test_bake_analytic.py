@@ -10,7 +10,7 @@ from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.settings import BakeSettings
+from hao_addon.core.bake.settings import BakeSettings
 
 R = 1.0
 
@@ -160,7 +160,7 @@ def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypat
 
 def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, monkeypatch):
     """Dispatching only the texel-list entries whose normal bin can face a batch's views
-    (core/normal_bins.py) gives the same map as testing every entry, and skips entries."""
+    (core/bake/normal_bins.py) gives the same map as testing every entry, and skips entries."""
     import hao_addon.gpu.bake_gather as bake_gather
     sphere = scenes.uv_sphere(1.0, (0.0, 0.0, 1.0), 48, 24)  # normals all round: bins to skip
     settings = BakeSettings(size=64, directions=32, method="gather", margin=0)

@@ -11,8 +11,8 @@ from hao_addon.bake import bake
 from hao_addon.core.geometry import face_normals_areas
 from hao_addon.core.objfile import obj_soup
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.settings import BakeSettings
-from hao_addon.core.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 
 SIZE, DIRS, REF_RAYS, TEXELS = 512, 128, 256, 400
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from conftest import DATA, ROOT
-from hao_addon.core import camera_math as cm
+from hao_addon.core.hao import camera_math as cm
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.view_settings import ViewAOSettings
+from hao_addon.core.hao.view_settings import ViewAOSettings
 
 
 def _load_character():
@@ -93,7 +93,7 @@ def test_only_changed_deformations_are_resynced(addon, gpu_context):
 
 def test_bad_input_messages(addon, gpu_context):
     from hao_ext.hao_addon.blender import sphere_proxies as sp
-    from hao_ext.hao_addon.core.lloyd import ProxyError
+    from hao_ext.hao_addon.core.proxies.lloyd import ProxyError
     man = _load_character()
     plane = bpy.data.objects["Plane"]
     with pytest.raises(ProxyError, match="no Armature modifier"):

@@ -122,7 +122,7 @@ def test_output_checks_come_before_any_work(dirs):
 def test_unwrap_warnings_for_overlapping_and_outside_uvs(tmp_path):
     import numpy as np
 
-    from hao_addon.core.uv_checks import uv_layout_warnings
+    from hao_addon.core.bake.uv_checks import uv_layout_warnings
     from hao_addon.core import scenes
     plane = scenes.grid_plane(2.0, 8)
     assert uv_layout_warnings(plane.uvs, 256, "p")[0] == []

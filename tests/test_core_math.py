@@ -8,10 +8,11 @@ import zlib
 import numpy as np
 import pytest
 
-from hao_addon.core import directions, kernels, normalization, scenes, seams, views
+from hao_addon.core import directions, kernels, scenes
+from hao_addon.core.bake import normalization, seams, views
 from hao_addon.core.geometry import face_normals_areas, uv_areas
 from hao_addon.core.imageio import exr32_bytes, png16_bytes
-from hao_addon.core.settings import BakeSettings
+from hao_addon.core.bake.settings import BakeSettings
 
 
 def test_fibonacci_sphere_is_unit_balanced_and_deterministic():
@@ -241,9 +242,9 @@ def test_face_chunks_and_hole_runs_are_conservative():
     past the hole) falls in a returned run; the runs cover far fewer faces than all."""
     from hao_addon.core import scenes
     from hao_addon.core.directions import bake_directions
-    from hao_addon.core.face_chunks import CHUNK_FACES, face_chunks, hole_chunk_ranges, hole_chunk_ranges_many
+    from hao_addon.core.bake.face_chunks import CHUNK_FACES, face_chunks, hole_chunk_ranges, hole_chunk_ranges_many
     from hao_addon.core.geometry import face_normals_areas, surface_holes
-    from hao_addon.core.views import fit_view
+    from hao_addon.core.bake.views import fit_view
     torus = scenes.torus(1.0, 0.4, (0, 0, 0), 96, 48).positions
     # A 3 x 3 patch of quads cut out (quad q is faces q and q + half; quad (i, j) = 48 i + j).
     quads = np.array([48 * i + j for i in (10, 11, 12) for j in (20, 21, 22)])
@@ -336,7 +337,7 @@ def test_normal_bin_cones_hold_every_face_a_view_can_face():
     """A batch of views tests only the bins whose cone reaches one of their hemispheres: every
     face with n . omega > 0 for some omega of the batch must be in such a bin."""
     from hao_addon.core.directions import bake_directions
-    from hao_addon.core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
+    from hao_addon.core.bake.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, proximity_order
     rng = np.random.default_rng(11)
     normals = rng.normal(size=(20000, 3))
     normals[:2000] = [0.0, 0.0, 1.0]  # many identical normals: a zero-width cone

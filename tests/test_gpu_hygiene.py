@@ -79,7 +79,7 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
 
 def test_constants_reach_glsl_from_python_only():
     """Each constant the GPU and its numpy mirror share is written once, in Python."""
-    from hao_addon.core.ao_pattern import GLSL_DEFINES
+    from hao_addon.core.hao.ao_pattern import GLSL_DEFINES
     from hao_addon.gpu.bake_gather import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE, VIEWS_PER_DISPATCH
     from hao_addon.gpu.shaders import SHADER_DIR
     sources = {p.name: p.read_text() for p in SHADER_DIR.iterdir()}

@@ -14,15 +14,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hao_addon.core import camera_math as cm
+from hao_addon.core.hao import camera_math as cm
 from hao_addon.core import scenes
-from hao_addon.core.ao_pattern import march_reference
-from hao_addon.core.bilateral import joint_bilateral_upsample
+from hao_addon.core.hao.ao_pattern import march_reference
+from hao_addon.core.hao.bilateral import joint_bilateral_upsample
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.view_scene import object_from_soup
-from hao_addon.core.view_settings import ViewAOSettings
-from hao_addon.core.voxel_grid import dominant_axes, grid_for_bounds, solid_reference, voxelize_reference
+from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_settings import ViewAOSettings
+from hao_addon.core.hao.voxel_grid import dominant_axes, grid_for_bounds, solid_reference, voxelize_reference
 
 R = 0.5
 

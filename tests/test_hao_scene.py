@@ -11,10 +11,10 @@ import bpy
 import numpy as np
 
 from conftest import ROOT
-from hao_addon.core import camera_math as cm
+from hao_addon.core.hao import camera_math as cm
 from hao_addon.core import scenes
-from hao_addon.core.view_scene import object_from_soup
-from hao_addon.core.view_settings import ViewAOSettings
+from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_settings import ViewAOSettings
 
 
 def _view(eye, width=96, height=72):

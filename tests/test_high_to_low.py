@@ -19,9 +19,9 @@ from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.projection import barycentric, ray_starts
-from hao_addon.core.settings import BakeSettings
-from hao_addon.core.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.projection import barycentric, ray_starts
+from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 
 BACKENDS = ["gather", "reference"]
 R = 0.5  # the relief: a ball of radius R resting on a wide floor at z = 0

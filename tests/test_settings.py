@@ -14,8 +14,8 @@ import bpy
 from conftest import ROOT
 from hao_addon.cli import build_parser
 from hao_addon.core.setting_spec import SettingError, check_value, specs
-from hao_addon.core.settings import BakeSettings
-from hao_addon.core.view_settings import RenderSize, ViewAOSettings
+from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings
 
 SETTINGS = [(BakeSettings, "bake", "hao_bake"), (ViewAOSettings, "render-ao", "hao_view"),
             (RenderSize, "render-ao", None)]

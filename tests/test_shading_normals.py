@@ -14,8 +14,8 @@ from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.directions import bake_directions
 from hao_addon.core.geometry import TriangleSoup, smooth_vertex_normals
-from hao_addon.core.settings import BakeSettings
-from hao_addon.core.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 
 BACKENDS = ["scatter", "gather", "reference"]
 GPU_BACKENDS = ["scatter", "gather"]

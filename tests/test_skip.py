@@ -9,7 +9,7 @@ import numpy as np
 from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.settings import BakeSettings
+from hao_addon.core.bake.settings import BakeSettings
 
 
 def test_occluders_beyond_max_distance_are_not_drawn(gpu_context):
@@ -70,8 +70,8 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
     (1 / S_f <= 4 / D), and a mean change under 1e-4."""
     import dataclasses
 
-    from hao_addon.core.plan import make_plan
-    from hao_addon.core.seams import finalize_map
+    from hao_addon.core.bake.plan import make_plan
+    from hao_addon.core.bake.seams import finalize_map
     from hao_addon.bakers import baker_for
 
     torus = scenes.torus(1.0, 0.45, (0, 0, 0), 48, 24)
@@ -108,8 +108,8 @@ def test_gather_draws_averted_faces_only_where_the_light_looks_into_a_hole(gpu_c
     torus were closed) lets light through the holes onto the sphere below: the runs matter."""
     import dataclasses
 
-    from hao_addon.core.plan import make_plan
-    from hao_addon.core.seams import finalize_map
+    from hao_addon.core.bake.plan import make_plan
+    from hao_addon.core.bake.seams import finalize_map
     from hao_addon.bakers import baker_for
 
     sphere = scenes.uv_sphere(0.5, (0.0, 0.0, 0.0), 64, 32)

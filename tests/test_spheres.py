@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from hao_addon.core import scenes
-from hao_addon.core.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
-from hao_addon.core.sphere_ao import (far_distance, sphere_occlusion, sphere_occlusion_quadrature,
-                                      spheres_accessibility)
+from hao_addon.core.proxies.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
+from hao_addon.core.proxies.sphere_ao import (far_distance, sphere_occlusion, sphere_occlusion_quadrature,
+                                              spheres_accessibility)
 
 
 def _random_configs(rng, n, below_horizon):
@@ -22,7 +22,7 @@ def _random_configs(rng, n, below_horizon):
         alpha = rng.uniform(-0.9, 0.9, n) * np.arcsin(radius / dist)
     else:
         alpha = np.arcsin(radius / dist) + rng.uniform(0.0, 1.0, n) * (np.pi / 2 - np.arcsin(radius / dist))
-    from hao_addon.core.ao_pattern import tangent_frames
+    from hao_addon.core.hao.ao_pattern import tangent_frames
     t, _ = tangent_frames(normals)
     direction = np.cos(alpha)[:, None] * t + np.sin(alpha)[:, None] * normals
     return normals, radius, dist[:, None] * direction

@@ -7,9 +7,9 @@ import numpy as np
 
 from hao_addon.core import scenes
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.sphere_ao import spheres_accessibility
-from hao_addon.core.view_scene import object_from_soup
-from hao_addon.core.view_settings import ViewAOSettings
+from hao_addon.core.proxies.sphere_ao import spheres_accessibility
+from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_settings import ViewAOSettings
 from test_hao import low_res_samples, view
 
 CENTRES = np.array([[0.0, 0.0, 0.45], [0.55, 0.1, 0.3], [0.35, 0.45, 0.4], [-0.5, 0.3, 0.25], [0.2, -0.5, 0.5]])
@@ -63,7 +63,7 @@ def _sphere_on_plane():
 
 
 def test_near_field_pass_equals_numpy_mirror(renderer):
-    from hao_addon.core.near_field import near_field_reference
+    from hao_addon.core.proxies.near_field import near_field_reference
     settings = ViewAOSettings(method="near", rays=12, max_distance=1.5, filter_size=0)
     vp, w, h = view((2.0, -2.4, 1.8), target=(0.0, 0.0, 0.3), width=96, height=72)
     renderer.render(_sphere_on_plane(), vp, w, h, settings)
@@ -102,7 +102,7 @@ def test_near_field_sphere_on_plane_against_analytic(renderer):
 
 
 def test_billboards_bound_the_projected_balls_tightly():
-    from hao_addon.core import camera_math as cm
+    from hao_addon.core.hao import camera_math as cm
     from hao_addon.gpu.sphere_far import billboard_rectangles
     vp = cm.perspective(0.8, 4 / 3, 0.1, 100.0) @ cm.look_at((0.0, -5.0, 1.0), (0.0, 0.0, 0.5))
     rng = np.random.default_rng(0)

@@ -10,7 +10,7 @@ from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.errors import BakeInputError
-from hao_addon.core.settings import BakeSettings
+from hao_addon.core.bake.settings import BakeSettings
 
 SIZE, DIRS = 128, 128
 

@@ -13,7 +13,7 @@ import pytest
 from conftest import DATA
 from hao_addon.core.geometry import uv_areas
 from hao_addon.core.objfile import read_obj
-from hao_addon.core.unwrap import UnwrapError, run_unwrap, unwrap_steps, xatlas_unwrap
+from hao_addon.core.bake.unwrap import UnwrapError, run_unwrap, unwrap_steps, xatlas_unwrap
 
 CUBE_V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
 CUBE_T = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],

@@ -16,8 +16,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from hao_addon.core.setting_spec import specs  # noqa: E402
-from hao_addon.core.settings import BakeSettings  # noqa: E402
-from hao_addon.core.view_settings import RenderSize, ViewAOSettings  # noqa: E402
+from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
+from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings  # noqa: E402
 
 TABLES = {"bake": (BakeSettings,), "view": (ViewAOSettings,), "render-size": (RenderSize,)}
 

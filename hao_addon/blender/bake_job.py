@@ -16,10 +16,10 @@ import bpy
 
 from ..bake import BakeResult, bake_steps
 from ..core.imageio import check_writable, write_ao_file
-from ..core.projection import HighToLow
+from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
-from ..core.settings import BakeSettings
-from ..core.unwrap import unwrap_steps
+from ..core.bake.settings import BakeSettings
+from ..core.bake.unwrap import unwrap_steps
 from . import images, mesh_data
 from .paths import OBJECT_TOKEN, absolute_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY

@@ -11,7 +11,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ..core.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
+from ..core.proxies.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
 from .mesh_data import read_positions
 
 CLUSTER_ATTRIBUTE = "hao_sphere_cluster"
@@ -87,7 +87,7 @@ def object_spheres(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tup
 
     Work per frame: one read of the evaluated vertices (the depsgraph's mesh, no copy), one
     comparison with the last frame's (memcmp speed), and only when they differ the sphere
-    update, in object space (see core.lloyd.sphere_proxies), then K centres to world space.
+    update, in object space (see core.proxies.lloyd.sphere_proxies), then K centres to world space.
     Radii scale by the largest axis scale of the object (exact for uniform scale)."""
     mesh = obj.data
     obj_eval = obj.evaluated_get(depsgraph)

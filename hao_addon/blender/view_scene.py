@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""SceneObjects (hao_addon/core/view_scene.py) from the depsgraph: evaluated visible meshes
+"""SceneObjects (hao_addon/core/hao/view_scene.py) from the depsgraph: evaluated visible meshes
 (modifiers and armatures applied) in world space, with smooth/flat corner normals as
 Blender shades them.
 
@@ -17,7 +17,7 @@ import mathutils
 import numpy as np
 
 from ..core.geometry import boundary_edge_fraction
-from ..core.view_scene import SOLID_BORDER_FRACTION, SceneObject
+from ..core.hao.view_scene import SOLID_BORDER_FRACTION, SceneObject
 from .mesh_data import read_positions
 
 BAKED_AO_PROPERTY = "hao_ao_image"  # set on objects by the Bake AO operator

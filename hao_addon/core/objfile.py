@@ -51,7 +51,7 @@ def obj_soup(path: str | Path, uvs: str = "file", size: int = 1024) -> TriangleS
             raise ValueError(f"{path} has no UVs")
         corner_uv = uv[tu]
     elif uvs == "xatlas":
-        from .unwrap import xatlas_unwrap
+        from .bake.unwrap import xatlas_unwrap
         corner_uv = xatlas_unwrap(v, t, size)
     else:
         corner_uv = None

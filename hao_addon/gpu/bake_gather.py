@@ -13,7 +13,7 @@ that list. Rasterizing the target in UV space again for every direction gives th
 fragments, but on llvmpipe a draw's per-triangle cost (about 0.25 us, even for triangles
 that are clipped away) made it half of each direction's time on a 70k-triangle mesh.
 The list is stored by normal bin, and each dispatch tests up to four nearby directions over the
-bins that can face them (core/normal_bins.py).
+bins that can face them (core/bake/normal_bins.py).
 Sums are float32 per entry in a fixed direction order (deterministic), float64 per texel at the end.
 """
 from __future__ import annotations
@@ -21,11 +21,11 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.face_chunks import face_chunks, hole_chunk_ranges_many
-from ..core.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, octahedral_coords, proximity_order
+from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
+from ..core.bake.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, octahedral_coords, proximity_order
 from ..core.errors import BakeInputError
-from ..core.plan import BakePlan
-from ..core.receivers import Receivers, uv_receivers
+from ..core.bake.plan import BakePlan
+from ..core.bake.receivers import Receivers, uv_receivers
 from . import util
 from .light_view import LightViewBaker, depth_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
@@ -90,7 +90,7 @@ GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
 NORMAL_BINNING = True
 # Texel centres of the target's own UVs are listed by a UV-space raster on the GPU (the fast
 # path); sub-texel samples and Selected-to-Active receivers are made on the CPU
-# (core/receivers.py) and uploaded. False: upload in every case (tests compare the two).
+# (core/bake/receivers.py) and uploaded. False: upload in every case (tests compare the two).
 GPU_TEXEL_LIST = True
 
 
@@ -164,7 +164,7 @@ class GatherBaker(LightViewBaker):
         # GatherViews: one buffer per bake, rewritten before each dispatch.
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
-        # Batches of nearby directions face nearly the same normal bins (core/normal_bins.py).
+        # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py).
         self.direction_order = proximity_order(plan.directions)
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
@@ -176,7 +176,7 @@ class GatherBaker(LightViewBaker):
 
     def _draw_order(self) -> np.ndarray | None:
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
-        order, so that those are a few runs (core/face_chunks.py)."""
+        order, so that those are a few runs (core/bake/face_chunks.py)."""
         plan = self.plan
         self.chunks = None
         self.hole_runs: dict[int, list[tuple[int, int]]] = {}
@@ -201,7 +201,7 @@ class GatherBaker(LightViewBaker):
         return plan_batch(self.plan, with_occluders=False, face_bins=bins)
 
     def _views_fitted(self, indices: list[int], views: list) -> None:
-        """Hole runs (core/face_chunks.py) of a batch of views, found together."""
+        """Hole runs (core/bake/face_chunks.py) of a batch of views, found together."""
         self.hole_runs = {}
         if self.chunks is not None and not self.plan.settings.ignore_back_faces:
             runs = hole_chunk_ranges_many(self.chunks, self.plan.holes, np.stack([v.matrix for v in views]),

@@ -25,7 +25,7 @@ import gpu
 import numpy as np
 
 from ..core.errors import BakeInputError
-from ..core.plan import BakePlan
+from ..core.bake.plan import BakePlan
 from . import util
 from .light_view import RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, soup_shader_info
 from .shaders import cached_shader, glsl_source

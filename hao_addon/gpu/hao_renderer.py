@@ -20,9 +20,9 @@ import gpu
 import numpy as np
 
 from ..core.errors import BakeInputError
-from ..core.view_scene import SceneObject, render_anchor, scene_bounds
-from ..core.view_settings import ViewAOSettings
-from ..core.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
+from ..core.hao.view_scene import SceneObject, render_anchor, scene_bounds
+from ..core.hao.view_settings import ViewAOSettings
+from ..core.hao.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
 from . import util
 from .hao_gbuffer import GBufferPass
 from .hao_sampling import AOSamplingPass, BilateralPass, LowGBufferPass

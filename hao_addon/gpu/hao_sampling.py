@@ -5,8 +5,8 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.ao_pattern import GLSL_DEFINES
-from ..core.view_settings import ViewAOSettings
+from ..core.hao.ao_pattern import GLSL_DEFINES
+from ..core.hao.view_settings import ViewAOSettings
 from . import util
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import add_defines, cached_shader, glsl_source

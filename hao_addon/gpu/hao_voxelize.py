@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Voxelization pass of Hybrid Ambient Occlusion: scene triangles -> bit-packed R32UI 3D grid
-(bits along z), by fragment-shader image atomics (rules: hao_addon/core/voxel_grid.py)."""
+(bits along z), by fragment-shader image atomics (rules: hao_addon/core/hao/voxel_grid.py)."""
 from __future__ import annotations
 
 import gpu
 import numpy as np
 
-from ..core.voxel_grid import GridSpec
+from ..core.hao.voxel_grid import GridSpec
 from . import util
 from .shaders import cached_shader, glsl_source
 
@@ -117,7 +117,7 @@ class VoxelPass(util.GPUPass):
         gpu.compute.dispatch(shader, -(-nx // 8), -(-ny // 8), nw)
         gpu.shader.unbind()
         words = util.texture_to_numpy(flat, np.uint32).reshape(nw, ny, nx)
-        from ..core.voxel_grid import unpack_bits
+        from ..core.hao.voxel_grid import unpack_bits
         return unpack_bits(words)
 
     def _release(self) -> None:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.plan import BakePlan
-from ..core.views import OrthoView
+from ..core.bake.plan import BakePlan
+from ..core.bake.views import OrthoView
 from . import util
 from .shaders import cached_shader, glsl_source
 

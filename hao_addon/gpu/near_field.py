@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Image-space near-field AO pass (Shanmugam & Arikan, section 4; compute). Rules and the
-numpy mirror: hao_addon/core/near_field.py."""
+numpy mirror: hao_addon/core/proxies/near_field.py."""
 from __future__ import annotations
 
 import gpu
 import numpy as np
 
-from ..core.ao_pattern import GLSL_DEFINES
-from ..core.near_field import camera_terms
+from ..core.hao.ao_pattern import GLSL_DEFINES
+from ..core.proxies.near_field import camera_terms
 from .hao_sampling import GROUP
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import add_defines, cached_shader, glsl_source

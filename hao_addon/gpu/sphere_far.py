@@ -11,7 +11,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.sphere_ao import far_distance
+from ..core.proxies.sphere_ao import far_distance
 from . import util
 from .shaders import cached_shader, glsl_source
 

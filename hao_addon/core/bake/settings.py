@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from .errors import BakeInputError
-from .setting_spec import Choice, setting, validate
+from ..errors import BakeInputError
+from ..setting_spec import Choice, setting, validate
 
 MAX_DIRECTIONS = 65536
 MAX_MAP_SIZE = 16384

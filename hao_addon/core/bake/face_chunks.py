@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import column_bounds
+from ..geometry import column_bounds
 
 # Faces per chunk, the unit a draw range is cut to: small, because every averted face in a
 # picked chunk is drawn (16 draws a third of the faces 128 did on the bunny). The box test

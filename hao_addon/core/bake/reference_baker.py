@@ -6,7 +6,7 @@ Same interface as ScatterBaker and GatherBaker (check_limits, construction from 
 run_direction, accumulated, stats, free) and behind the same factory (hao_addon.bakers), so
 every bake test runs it on the scenes the GPU passes bake. Receivers are the texel centres
 of the target's UV layout (as the gather's), their sub-texel samples, or the high-poly
-points of a Selected-to-Active bake (core/receivers.py); per direction each adds (V w, w) with
+points of a Selected-to-Active bake (core/bake/receivers.py); per direction each adds (V w, w) with
 w = weight(omega . n_s) / S interpolated like the GPU passes interpolate them, and V the
 visibility: 0 below the true surface (the terminator rule of Cycles' AO pass), else one ray
 towards the light with the plan's max distance, falloff and back-face rule. Slow (a Python
@@ -17,11 +17,11 @@ from __future__ import annotations
 import numpy as np
 from mathutils import Vector
 
-from .errors import BakeInputError
-from .kernels import occlusion_weight
+from ..errors import BakeInputError
+from ..kernels import occlusion_weight
 from .normalization import hemisphere_weight
 from .plan import BakePlan
-from .reference import build_bvh, first_hit, ray_offset
+from ..reference import build_bvh, first_hit, ray_offset
 from .receivers import uv_receivers
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for

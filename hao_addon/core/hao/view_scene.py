@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .geometry import TriangleSoup, boundary_edge_fraction, face_normals_areas
+from ..geometry import TriangleSoup, boundary_edge_fraction, face_normals_areas
 
 # Objects with at most this fraction of border edges are voxelized as solids (a scan with a
 # few holes, like the Stanford bunny's open base, at 0.2 %); sheets and planes stay surfaces.

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels import wendland
+from ..kernels import wendland
 
 
 def _pass(values: np.ndarray, positions: np.ndarray, normals: np.ndarray, valid: np.ndarray,

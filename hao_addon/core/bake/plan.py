@@ -11,10 +11,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .directions import bake_directions
-from .errors import BakeInputError
-from .geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
-                       surface_holes, uv_areas, weld)
+from ..directions import bake_directions
+from ..errors import BakeInputError
+from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
+                        surface_holes, uv_areas, weld)
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, check_high_to_low, project, ray_starts
 from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
@@ -75,7 +75,7 @@ class BakePlan:
     # distance or ignored back faces change what a depth map must hold).
     holes: list[np.ndarray] | None = None
     # Selected to Active: the high-poly points the target's texels project to
-    # (core/projection.py); the target itself is then neither a receiver nor drawn.
+    # (core/bake/projection.py); the target itself is then neither a receiver nor drawn.
     projected: Receivers | None = None
     stats: dict = field(default_factory=dict)
 
@@ -280,7 +280,7 @@ def _project(target: TriangleSoup, request: HighToLow, settings: BakeSettings, d
              centre: np.ndarray, scale: float, pixel_size: float, warnings: list[str]
              ) -> tuple[Receivers, dict, list[str]]:
     """The receivers of a Selected-to-Active bake: the source points the target's texel
-    samples project to (core/projection.py), with the sources' own shading normals. Returns
+    samples project to (core/bake/projection.py), with the sources' own shading normals. Returns
     them, stats (and the normalized corners of the hit triangles under "corners"), warnings."""
     texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
     origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)

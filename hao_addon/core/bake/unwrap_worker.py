@@ -3,7 +3,7 @@
 
 xatlas holds the interpreter lock for the whole unwrap (seconds for 100k triangles), so in
 the calling process no signal handler, progress update or Esc key runs until it returns.
-``core/unwrap.py`` therefore runs it here, in a child that can be killed at once. This file
+``core/bake/unwrap.py`` therefore runs it here, in a child that can be killed at once. This file
 imports only numpy and xatlas: the child must not need the add-on's package to be importable.
 """
 from __future__ import annotations

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels import wendland
+from ..kernels import wendland
 
 GOLDEN_FRACTION = 0.6180339887498949
 SELF_OFFSET = 1.75  # voxels; > sqrt(3)

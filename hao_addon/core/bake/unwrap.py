@@ -21,7 +21,7 @@ from typing import Generator
 
 import numpy as np
 
-from .errors import BakeInputError
+from ..errors import BakeInputError
 from .unwrap_worker import atlas_uvs
 
 # Texels kept free around each chart (>= 2 so the bake's one-texel tent and bilinear lookups

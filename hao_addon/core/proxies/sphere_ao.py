@@ -70,8 +70,8 @@ def sphere_occlusion_quadrature(points: np.ndarray, normals: np.ndarray, centre:
                                 samples: int = 128) -> np.ndarray:
     """Exact cosine-weighted occluded fraction of one sphere (horizon clipping included) by a
     samples x samples midpoint rule on Malley's disk, for testing sphere_occlusion."""
-    from .ao_pattern import tangent_frames
-    from .directions import malley_quadrature
+    from ..hao.ao_pattern import tangent_frames
+    from ..directions import malley_quadrature
     local = malley_quadrature(samples)
     normals = np.asarray(normals, np.float64)
     t, s = tangent_frames(normals)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .setting_spec import Choice, setting, validate
+from ..setting_spec import Choice, setting, validate
 
 GRID_MIN, GRID_MAX = 64, 512
 MAX_RENDER_SIDE = 65536

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .ao_pattern import GOLDEN_FRACTION, pcg3d
+from ..hao.ao_pattern import GOLDEN_FRACTION, pcg3d
 
 
 def camera_terms(view_proj: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:

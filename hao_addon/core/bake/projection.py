@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import BakeInputError
-from .geometry import TriangleSoup, smooth_vertex_normals
+from ..errors import BakeInputError
+from ..geometry import TriangleSoup, smooth_vertex_normals
 
 
 @dataclass
@@ -29,7 +29,7 @@ class HighToLow:
     shading normals where they have them). extrusion_normals: (Ft, 3, 3) the direction the
     cage extrusion pushes each target corner, in the low-poly's object space (None: Blender's
     smooth vertex normals of the target, low_linear the identity). cage: (Ft, 3, 3) world corners of a cage object with the target's triangles, or
-    None. The cage extrusion and max ray distance are bake settings (core/settings.py)."""
+    None. The cage extrusion and max ray distance are bake settings (core/bake/settings.py)."""
 
     sources: list[TriangleSoup]
     extrusion_normals: np.ndarray | None = None
