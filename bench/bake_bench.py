@@ -99,8 +99,8 @@ def hao_runs(soup, size, method, directions_list, view_samples=2.0, high_to_low=
     out = []
     # Warm-up (not timed): shader compilation (LLVM JIT, ~0.1 s per variant) happens once per
     # session, and Cycles gets the same courtesy in cycles_bake.
-    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0, **settings),
-         use_cache=False, high_to_low=high_to_low)
+    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0,
+                                **settings), use_cache=False, high_to_low=high_to_low)
     for d in directions_list:
         t = time.perf_counter()
         # margin=0 as in cycles_bake: neither grows islands (error is measured inside them).
@@ -174,8 +174,9 @@ def high_to_low_rows(size, dirs, spp, truth_spp):
     source = mesh_data.evaluated_soup(high, dg, None)
     normals, linear = mesh_data.extrusion_normals(low, dg)
     request = HighToLow([source], normals, low_linear=linear)
-    (_, truth_s, truth), = cycles_ao_bake(low, size, [truth_spp], seed=0, sources=(high,), cage_extrusion=PAIR_EXTRUSION,
-                                          max_ray_distance=PAIR_MAX_RAY, warm_up=True, log=True)
+    (_, truth_s, truth), = cycles_ao_bake(low, size, [truth_spp], seed=0, sources=(high,),
+                                          cage_extrusion=PAIR_EXTRUSION, max_ray_distance=PAIR_MAX_RAY,
+                                          warm_up=True, log=True)
     face, _bary, hits = texel_surface_samples(low_soup.uvs, size)
     runs = {"gather": [], "cycles": []}
     for s, dt, ao in cycles_ao_bake(low, size, spp, seed=1, sources=(high,), cage_extrusion=PAIR_EXTRUSION,
@@ -222,7 +223,8 @@ def plot(results, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    panels = [(f"{name} (flat)", m, "interior RMSE vs 1024-ray reference") for name, m in results.get("meshes", {}).items()]
+    panels = [(f"{name} (flat)", m, "interior RMSE vs 1024-ray reference")
+              for name, m in results.get("meshes", {}).items()]
     for group, label in (("smooth", "smooth"), ("high_to_low", "Selected to Active")):
         for name, m in results.get(group, {}).items():
             panels.append((f"{name} ({label})", m, f"interior RMSE vs Cycles {m['truth']['samples']} spp"))

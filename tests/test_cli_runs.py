@@ -82,8 +82,8 @@ def test_object_token_and_json_report(dirs):
 
 
 def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
-    """An OBJ's 's' groups and 'vn' normals reach the bake through Blender's importer (the
-    evaluated mesh's corner normals); --normals face bakes flat anyway."""
+    """An OBJ's 's' groups and 'vn' normals, and a glTF's normals, reach the bake through
+    Blender's importers (the evaluated mesh's corner normals); --normals face bakes flat anyway."""
     out, tmp = dirs
     smooth = tmp.parent / "spot_smooth.obj"
     lines = SPOT.read_text().splitlines(keepends=True)
@@ -102,6 +102,7 @@ def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
     assert corners(smooth) > 0.9 * total  # smooth: nearly every corner leans off its face
     assert corners(smooth, "--normals", "face") == 0
     assert corners(suzanne) > 0
+    assert corners(ROOT / "tests" / "data" / "CesiumMan.glb") > 0
 
 
 def test_output_checks_come_before_any_work(dirs):

@@ -3,13 +3,14 @@
 GPU MeshMapper): per direction render a depth map from the light, then test every texel
 centre of the target against it.
 
-Same interface as ScatterBaker. Differences a user sees: one sample per texel centre (no
-area average, no stretch correction needed), shadow-map bias (a slope-scaled offset can hide
+Same interface as ScatterBaker. Differences a user sees: point samples (the texel centre, or
+the sub-texel and Selected-to-Active receivers of core/bake/receivers.py; no area average, no
+stretch correction needed), shadow-map bias (a slope-scaled offset can hide
 contact occlusion thinner than a few light-view pixels), and unlimited distance only.
 
 The target is rasterized in UV space once per bake, into a compact texel list (surface point,
-face, texel of every covered texel centre), and the directions' tests are compute passes over
-that list. Rasterizing the target in UV space again for every direction gives the same
+face, texel of every covered texel centre), or a CPU receiver list is uploaded as that list,
+and the directions' tests are compute passes over it. Rasterizing the target in UV space again for every direction gives the same
 fragments, but on llvmpipe a draw's per-triangle cost (about 0.25 us, even for triangles
 that are clipped away) made it half of each direction's time on a 70k-triangle mesh.
 The list is stored by normal bin, and each dispatch tests up to four nearby directions over the
@@ -169,7 +170,8 @@ class GatherBaker(LightViewBaker):
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self._build_texel_list()
-        self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0, texel_list_entries=self.entry_count,
+        self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0,
+                          texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
                           views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0,
                           shading_normals=self.plan.smooth_shading)

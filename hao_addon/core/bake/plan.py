@@ -16,11 +16,11 @@ from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
 from .normalization import corner_normalizers, face_normalizers
-from .projection import HighToLow, check_high_to_low, project, ray_starts
-from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
+from .projection import HighToLow, check_high_to_low, projected_receivers
+from .receivers import Receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
-from .views import OrthoView, fit_views
+from .views import OrthoView, cell_corners, fit_views
 
 # The light view never exceeds this many pixels per side (GPU limit is checked separately);
 # at 8192^2 one RGBA32F view buffer takes 1 GiB.
@@ -34,11 +34,8 @@ DENSITY_PERCENTILE = 0.10
 # that, the bake uses the footprint-splitting shader variant (slower, so only then).
 FOOTPRINT_SPLIT = 1.5
 DENSE_AREA_LIMIT = 0.005
-# Selected to Active: warn when more than this fraction of the sampled texels found no
-# high-poly surface (they are filled from their neighbours, as margin).
-MISSED_TEXELS_WARNING = 0.01
 # Selected-to-Active light views are fitted to the corners of grid cells this many light-view
-# pixels wide that hold receivers (plan.cell_corners): a few thousand points instead of
+# pixels wide that hold receivers (views.cell_corners): a few thousand points instead of
 # millions, for windows at most that much wider.
 VIEW_FIT_CELL = 16
 
@@ -234,8 +231,9 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
 
     projected, projection_stats = None, {}
     if high_to_low is not None:
-        projected, projection_stats, uv_warnings = _project(target, high_to_low, settings, directions, centre, scale,
-                                                            pixel_size, uv_warnings)
+        projected, projection_stats, warning = projected_receivers(target, high_to_low, settings, directions,
+                                                                   centre, scale)
+        uv_warnings = uv_warnings + ([warning] if warning else [])
     drawn_parts = [o_pos.reshape(-1, 3)] if projected is not None else [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)]
     drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
@@ -250,7 +248,7 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     # Selected to Active the corners of the source triangles that receivers lie on.
     target_points = t_pos.reshape(-1, 3)[target_weld[0]]
     if projected is not None:
-        target_points = projection_stats.pop("corners")
+        target_points = cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
 
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
                  zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
@@ -266,49 +264,6 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
                     closed, holes, projected, stats)
-
-
-def cell_corners(points: np.ndarray, cell: float) -> np.ndarray:
-    """(k, 3) corners of the grid cells (side `cell`) that hold points (n, 3): a few points
-    whose projection along any direction covers the points' (light views are fitted to them)."""
-    keys = np.unique(np.floor(points / cell).astype(np.int64), axis=0)
-    offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-    return ((keys[:, None, :] + offsets[None]) * cell).reshape(-1, 3)
-
-
-def _project(target: TriangleSoup, request: HighToLow, settings: BakeSettings, directions: np.ndarray,
-             centre: np.ndarray, scale: float, pixel_size: float, warnings: list[str]
-             ) -> tuple[Receivers, dict, list[str]]:
-    """The receivers of a Selected-to-Active bake: the source points the target's texel
-    samples project to (core/bake/projection.py), with the sources' own shading normals. Returns
-    them, stats (and the normalized corners of the hit triangles under "corners"), warnings."""
-    texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
-    origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
-    triangles = np.concatenate([s.positions for s in request.sources])
-    hit_face, hit_bary = project(origins, rays, triangles, settings.max_ray_distance)
-    hit = hit_face >= 0
-    hf, hb = hit_face[hit], hit_bary[hit]
-    normals, _ = face_normals_areas(triangles)
-    mesh = settings.normals == "mesh"
-    shading_corners = np.concatenate([
-        corner_shading_normals(s.positions, s.normals if mesh else None, face_normals_areas(s.positions)[0])[0]
-        for s in request.sources])
-    shading = interpolate_unit(shading_corners, hf, hb)
-    geometric = normals[hf]
-    points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
-    receivers = Receivers(points, geometric, shading, exact_inverse_normalizers(shading, directions, settings.weighting),
-                          texel[hit])
-    sampled = np.unique(texel)
-    missed = len(sampled) - len(np.unique(receivers.texel))
-    if len(sampled) and missed > MISSED_TEXELS_WARNING * len(sampled):
-        warnings = [*warnings, f"{missed} of {len(sampled)} texels of '{target.name}' ({100.0 * missed / len(sampled):.1f} %) "
-                               f"found no high-poly surface and were filled from their neighbours: raise the cage "
-                               f"extrusion or the max ray distance, or use a cage object"]
-    smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
-    corners = cell_corners(points, VIEW_FIT_CELL * pixel_size) if len(points) else np.zeros((1, 3))
-    stats = dict(high_poly_faces=int(len(triangles)), projected_samples=int(len(texel)), missed_samples=int((~hit).sum()),
-                 missed_texels=int(missed), smooth_receivers=smooth, corners=corners)
-    return receivers, stats, warnings
 
 
 def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,

@@ -15,12 +15,19 @@ then bake the hit points like any other receivers).
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import BakeInputError
-from ..geometry import TriangleSoup, smooth_vertex_normals
+from ..geometry import TriangleSoup, corner_shading_normals, face_normals_areas, smooth_vertex_normals
+from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
+from .settings import BakeSettings
+
+# Warn when more than this fraction of the sampled texels found no high-poly surface (they
+# are filled from their neighbours, as margin).
+MISSED_TEXELS_WARNING = 0.01
 
 
 @dataclass
@@ -28,8 +35,8 @@ class HighToLow:
     """A Selected-to-Active request. sources: the high-poly meshes (world space, with their
     shading normals where they have them). extrusion_normals: (Ft, 3, 3) the direction the
     cage extrusion pushes each target corner, in the low-poly's object space (None: Blender's
-    smooth vertex normals of the target, low_linear the identity). cage: (Ft, 3, 3) world corners of a cage object with the target's triangles, or
-    None. The cage extrusion and max ray distance are bake settings (core/bake/settings.py)."""
+    smooth vertex normals of the target, low_linear the identity). cage: (Ft, 3, 3) world
+    corners of a cage object with the target's triangles, or None. The cage extrusion and max ray distance are bake settings (core/bake/settings.py)."""
 
     sources: list[TriangleSoup]
     extrusion_normals: np.ndarray | None = None
@@ -119,3 +126,39 @@ def barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     w = (d11 * p2 - d12 * p1) / safe
     out = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
     return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-30)
+
+
+def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, directions: np.ndarray,
+                        centre: np.ndarray, scale: float) -> tuple[Receivers, dict, str | None]:
+    """The receivers of a Selected-to-Active bake: the source points the target's texel
+    samples project to, with the sources' own shading normals (settings.normals), exact
+    1 / S, positions normalized by (centre (3,), scale). Returns them, stats, and a warning
+    when many texels found nothing."""
+    texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
+    origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
+    triangles = np.concatenate([s.positions for s in request.sources])
+    started = time.perf_counter()
+    hit_face, hit_bary = project(origins, rays, triangles, settings.max_ray_distance)
+    seconds = time.perf_counter() - started
+    hit = hit_face >= 0
+    hf, hb = hit_face[hit], hit_bary[hit]
+    mesh = settings.normals == "mesh"
+    corners = np.concatenate([corner_shading_normals(s.positions, s.normals if mesh else None,
+                                                     face_normals_areas(s.positions)[0])[0] for s in request.sources])
+    shading = interpolate_unit(corners, hf, hb)
+    geometric = face_normals_areas(triangles)[0][hf]
+    points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
+    inv_s = exact_inverse_normalizers(shading, directions, settings.weighting)
+    receivers = Receivers(points, geometric, shading, inv_s, texel[hit])
+    sampled = len(np.unique(texel))
+    missed = sampled - len(np.unique(receivers.texel))
+    warning = None
+    if sampled and missed > MISSED_TEXELS_WARNING * sampled:
+        warning = (f"{missed} of {sampled} texels of '{target.name}' ({100.0 * missed / sampled:.1f} %) found no "
+                   f"high-poly surface and were filled from their neighbours: raise the cage extrusion or the max "
+                   f"ray distance, or use a cage object")
+    smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
+    stats = dict(high_poly_faces=int(len(triangles)), projected_samples=int(len(texel)),
+                 missed_samples=int((~hit).sum()), missed_texels=int(missed), projection_seconds=round(seconds, 3),
+                 smooth_receivers=smooth)
+    return receivers, stats, warning

@@ -42,7 +42,8 @@ class ReferenceBaker:
         rays = cls.rays_needed(plan)
         if rays > MAX_REFERENCE_RAYS:
             raise BakeInputError(
-                f"the reference (CPU ray tracing) bake would trace up to {rays:,} rays (size^2 x samples per texel x directions), "
+                f"the reference (CPU ray tracing) bake would trace up to {rays:,} rays "
+                f"(size^2 x samples per texel x directions), "
                 f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
 
     def __init__(self, plan: BakePlan) -> None:

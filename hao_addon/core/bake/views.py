@@ -100,3 +100,13 @@ def _view_from_extent(basis: np.ndarray, lo_all: np.ndarray, hi_all: np.ndarray,
     uvw_from_world[:3, :3] = basis
     matrix = (ndc_from_uvw @ uvw_from_world).astype(np.float32)
     return OrthoView(matrix, width, height, basis[2], pixel_size, float(zlo), float(zhi))
+
+
+def cell_corners(points: np.ndarray, cell: float) -> np.ndarray:
+    """(k, 3) corners of the grid cells (side `cell`) that hold points (n, 3): a few points
+    whose projection along any direction covers the points' (light views are fitted to them)."""
+    if len(points) == 0:
+        return np.zeros((1, 3))
+    keys = np.unique(np.floor(points / cell).astype(np.int64), axis=0)
+    offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    return ((keys[:, None, :] + offsets[None]) * cell).reshape(-1, 3)
