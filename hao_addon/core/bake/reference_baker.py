@@ -34,6 +34,9 @@ class ReferenceBaker:
 
     @staticmethod
     def rays_needed(plan: BakePlan) -> int:
+        """Rays of a whole bake at most (one per receiver and direction)."""
+        if plan.projected is not None:
+            return len(plan.projected) * plan.settings.directions
         return plan.settings.size ** 2 * plan.settings.sample_count * plan.settings.directions
 
     @classmethod
