@@ -6,8 +6,9 @@
  * are added one direction at a time in direction order, the same arithmetic as one
  * direction per dispatch, and the same on every run. */
 
+#ifndef MAX_DISTANCE
 /* Visibility of `position` from one light view: view_proj maps to clip space, view_info is
- * (width, height, pixel depth in clip z units, unused). */
+ * (width, height, pixel depth in clip z units, depth range). */
 float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 position, float cos_theta)
 {
   vec3 light_pos = (view_proj * vec4(position, 1.0)).xyz;
@@ -25,6 +26,40 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
   float depth = light_pos.z * 0.5 + 0.5;
   return (depth - bias <= texelFetch(depth_tex, px, 0).r) ? 1.0 : 0.0;
 }
+#endif
+
+#ifdef MAX_DISTANCE
+/* Max distance: the occluder nearest to `position` towards the light is the largest listed
+ * depth in front of it by more than the slope-scaled bias (its own surface, rasterized at
+ * the pixel centre, lies within that bias); view_info.w is the depth range in normalized
+ * units, so depth differences times it are distances (orthographic view). */
+float visible_from_layers(mat4 view_proj, vec4 view_info, vec3 position, float cos_theta)
+{
+  vec3 light_pos = (view_proj * vec4(position, 1.0)).xyz;
+  ivec2 view_size = ivec2(view_info.xy);
+  ivec2 px = ivec2(floor((light_pos.xy * 0.5 + 0.5) * view_info.xy));
+  if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, view_size))) {
+    return 1.0;
+  }
+  float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 100.0);
+  float bias = (1.5 * tan_theta + 0.5) * view_info.z;
+  float depth = light_pos.z * 0.5 + 0.5;
+  int count = min(int(imageLoad(layer_count, px).r), LAYERS);
+  float z_front = -1.0;
+  for (int i = 0; i < count; i++) {
+    float z = uintBitsToFloat(imageLoad(layer_depth, ivec3(px, i)).r);
+    if (z < depth - bias && z > z_front) {
+      z_front = z;
+    }
+  }
+  return (z_front >= 0.0) ? occluder_visibility((depth - z_front) * view_info.w, max_distance) : 1.0;
+}
+#  define VISIBLE(depth_tex, k, cos_true) \
+    visible_from_layers(views.view_proj[k], views.view_info[k], position.xyz, cos_true)
+#else
+#  define VISIBLE(depth_tex, k, cos_true) \
+    visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_true)
+#endif
 
 /* Hemisphere weight of a light at cos_theta > 0 (times 1 / S, added in GATHER_VIEW). */
 #ifdef UNIFORM_WEIGHTING
@@ -44,8 +79,7 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
     if (cos_theta > 0.0) { \
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
       float cos_true = dot(geometric, views.omega[k].xyz); \
-      float visible = (cos_true > 0.0) ? \
-          visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_true) : 0.0; \
+      float visible = (cos_true > 0.0) ? VISIBLE(depth_tex, k, cos_true) : 0.0; \
       sum += vec2(weight * visible, weight); \
     } \
   }
@@ -55,7 +89,7 @@ float visible_from(sampler2D depth_tex, mat4 view_proj, vec4 view_info, vec3 pos
     float cos_theta = dot(normal, views.omega[k].xyz); \
     if (cos_theta > 0.0) { \
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
-      sum += vec2(weight * visible_from(depth_tex, views.view_proj[k], views.view_info[k], position.xyz, cos_theta), weight); \
+      sum += vec2(weight * VISIBLE(depth_tex, k, cos_theta), weight); \
     } \
   }
 #endif

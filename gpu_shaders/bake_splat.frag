@@ -44,17 +44,7 @@ void main()
       z_front = z;
     }
   }
-  float visible = 1.0;
-  if (z_front >= 0.0) {
-    float t = (z_self - z_front) * depth_span;
-    float x = clamp(t / max_distance, 0.0, 1.0);
-#  ifdef WENDLAND_FALLOFF
-    /* Hybrid AO paper, equation 3. */
-    visible = 1.0 - pow(1.0 - x, 4.0) * (4.0 * x + 1.0);
-#  else
-    visible = (t < max_distance) ? 0.0 : 1.0;
-#  endif
-  }
+  float visible = (z_front >= 0.0) ? occluder_visibility((z_self - z_front) * depth_span, max_distance) : 1.0;
 #else
   /* Visible: this fragment is the nearest surface. Both passes run the same vertex shader,
    * so the depths agree to the last bit on conforming drivers; the tolerance only absorbs

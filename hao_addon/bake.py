@@ -79,7 +79,8 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
 
     plan = make_plan(target, occluders, settings, high_to_low)
     from .bakers import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
-    baker_cls = baker_for(settings.resolved_method)
+    method = settings.method_for(high_to_low is not None)
+    baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
     try:
@@ -92,7 +93,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
     finally:
         baker.free()
     ao, covered, filled = finalize_map(numerator, denominator, settings.margin)
-    stats = {**plan.stats, **gpu_stats, "method": settings.resolved_method, "covered_texels": int(covered.sum()),
+    stats = {**plan.stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "seconds": time.perf_counter() - t0, "cache_hit": False}
     result = BakeResult(ao, covered, filled, stats)
     if key is not None:

@@ -154,8 +154,8 @@ CASES = [
      "view samples must be between 0.25"),
     ("seed-negative", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--seed", "-1"], 2, "(--seed)"),
     ("unknown-falloff", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--falloff", "cubic"], 2, "invalid choice"),
-    ("gather-with-distance", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--method", "gather",
-                              "--max-distance", "1"], 2, "gather"),
+    ("cage-without-high-poly", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--cage", "spot"], 2,
+     "--cage needs --high-poly"),
     # names
     ("unknown-uv-map", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--uv-map", "Nope"], 2,
      "no UV map named 'Nope'"),

@@ -66,7 +66,7 @@ def test_floor_next_to_wall_unlimited(gpu_context, method):
     assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, method)
 
 
-@pytest.mark.parametrize("method", ["scatter", "reference"])
+@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
 @pytest.mark.parametrize("falloff", ["none", "wendland"])
 @pytest.mark.parametrize("max_distance", [0.5, 1.0])
 def test_floor_next_to_wall_with_max_distance(gpu_context, falloff, max_distance, method):
@@ -74,7 +74,7 @@ def test_floor_next_to_wall_with_max_distance(gpu_context, falloff, max_distance
     size, directions = (32 if method == "reference" else 128), 256
     res = bake(floor, [wall], BakeSettings(size=size, directions=directions, max_distance=max_distance,
                                            falloff=falloff, margin=0, method=method), use_cache=False)
-    if method == "scatter":
+    if method != "reference":
         assert res.stats["layered"] and res.stats["layer_overflow_pixels"] == 0
     pts, mask = texel_points(floor, size)
     ref = scenes.wall_accessibility(-pts[..., 0].ravel(), max_distance, falloff).reshape(size, size)
@@ -176,14 +176,16 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
     assert stats[1]["texel_tests_skipped"] == 0
 
 
-def test_wendland_falloff_is_the_papers_kernel(gpu_context):
-    """The scatter's falloff is w(x) = (1 - x)^4 (4x + 1), not a kernel of the same shape:
+@pytest.mark.parametrize("method", ["scatter", "gather"])
+def test_wendland_falloff_is_the_papers_kernel(gpu_context, method):
+    """The GPU falloff (gpu_shaders/bake_falloff.glsl, shared by both variants) is
+    w(x) = (1 - x)^4 (4x + 1), not a kernel of the same shape:
     with d_max past the floor's far edge the weight matters at every texel, and at D = 1024
     the bias bound is five times smaller than what (1 - x)^4 (3x + 1) would add."""
     floor, wall = floor_and_wall(width=20.0, height=10.0)  # a wall that is infinite within reach
     size, directions, max_distance = 128, 1024, 4.0
     res = bake(floor, [wall], BakeSettings(size=size, directions=directions, max_distance=max_distance,
-                                           falloff="wendland", margin=0, method="scatter"), use_cache=False)
+                                           falloff="wendland", margin=0, method=method), use_cache=False)
     pts, mask = texel_points(floor, size)
     xs = -pts[..., 0].ravel()
     ref = scenes.wall_accessibility(xs, max_distance, "wendland").reshape(size, size)

@@ -121,7 +121,7 @@ os._exit(0)  # bpy 4.2 segfaults at interpreter exit after a glTF export (exit -
     (["samples/spot.obj", "--out", "x.png", "--uv-map", "Nope"], "no UV map named 'Nope'"),
     (["samples/spot.obj", "--out", "x.png", "--object", "Nope"], "no mesh object named 'Nope'"),
     (["samples/spot.obj", "--out", "x.png", "--falloff", "cubic"], "invalid choice"),
-    (["samples/spot.obj", "--out", "x.png", "--method", "gather", "--max-distance", "1"], "gather"),
+    (["samples/spot.obj", "--out", "x.png", "--samples-per-texel", "5"], "invalid choice"),
 ])
 def test_cli_bad_input_exits_2_with_one_line(tmp_path, args, message):
     proc = run(["-m", "hao_addon", "bake", *args])

@@ -28,13 +28,16 @@ def test_every_shader_variant_compiles(gpu_context):
     from hao_addon.gpu import bake_gather, bake_scatter
     from hao_addon.gpu import light_view
     light_view.depth_shader()
-    bake_scatter.layers_shader()
+    light_view.layers_shader()
     for uniform in (False, True):
         for layered in (False, True):
             for wendland in (False, True):
                 for footprint in (False, True):
                     bake_scatter.splat_shader(uniform, layered, wendland, footprint)
-        bake_gather.gather_shader(uniform)
+        for falloff in (None, "none", "wendland"):
+            for shading in (False, True):
+                bake_gather.gather_shader(uniform, 1, shading, falloff)
+        bake_gather.gather_shader(uniform, 4)
         bake_gather.texel_list_shader(fill=uniform)
     from hao_addon.gpu import hao_composite, hao_gbuffer, hao_sampling, hao_voxelize
     from hao_addon.gpu.shaders import cached_shader

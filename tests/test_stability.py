@@ -23,8 +23,8 @@ def transformed(soup, scale=1.0, offset=(0.0, 0.0, 0.0)):
     return TriangleSoup(soup.positions * scale + np.asarray(offset), soup.uvs, name=soup.name)
 
 
-# (method, max distance) pairs: the gather supports unlimited distance only.
-VARIANTS = [("scatter", 0.0), ("scatter", 1.5), ("gather", 0.0)]
+# (method, max distance) pairs: each GPU variant with unlimited and with limited distance.
+VARIANTS = [("scatter", 0.0), ("scatter", 1.5), ("gather", 0.0), ("gather", 1.5)]
 
 
 def settings(method, max_distance=0.0, **kw):

@@ -6,7 +6,9 @@ centre of the target against it.
 Same interface as ScatterBaker. Differences a user sees: point samples (the texel centre, or
 the sub-texel and Selected-to-Active receivers of core/bake/receivers.py; no area average, no
 stretch correction needed), shadow-map bias (a slope-scaled offset can hide
-contact occlusion thinner than a few light-view pixels), and unlimited distance only.
+contact occlusion thinner than a few light-view pixels). With a max distance each view's
+depth map becomes per-pixel depth lists (the scatter's, light_view.layers_prepass), and a
+receiver's nearest occluder towards the light is the deepest entry in front of it.
 
 The target is rasterized in UV space once per bake, into a compact texel list (surface point,
 face, texel of every covered texel centre), or a CPU receiver list is uploaded as that list,
@@ -28,7 +30,7 @@ from ..core.errors import BakeInputError
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers, uv_receivers
 from . import util
-from .light_view import LightViewBaker, depth_prepass, plan_batch
+from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
 
 # Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
@@ -106,11 +108,17 @@ def cpu_receivers(plan: BakePlan) -> Receivers | None:
 
 
 def views_per_dispatch(plan: BakePlan) -> int:
+    """Max-distance bakes test one direction per dispatch (each needs its per-pixel depth
+    lists, LAYERS deep, which are too large to keep four of)."""
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
-    return VIEWS_PER_DISPATCH if plan.max_view_side <= MAX_BATCHED_VIEW_SIDE else 1
+    if plan.settings.max_distance > 0.0 or plan.max_view_side > MAX_BATCHED_VIEW_SIDE:
+        return 1
+    return VIEWS_PER_DISPATCH
 
 
-def _gather_info(uniform: bool, views: int, shading: bool) -> "gpu.types.GPUShaderCreateInfo":
+def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None) -> "gpu.types.GPUShaderCreateInfo":
+    """falloff: None for unlimited distance (depth maps), else the max-distance falloff
+    ('none', 'wendland'), tested against per-pixel depth lists."""
     info = gpu.types.GPUShaderCreateInfo()
     if shading:
         info.define("SHADING_NORMALS", "1")
@@ -124,19 +132,31 @@ def _gather_info(uniform: bool, views: int, shading: bool) -> "gpu.types.GPUShad
     info.push_constant('INT', "entry_end")
     info.typedef_source(glsl_source("bake_gather_views.glsl"))
     info.uniform_buf(0, "GatherViews", "views")
-    for k in range(views):
-        info.sampler(k, 'FLOAT_2D', f"depth_tex{k}")
     info.image(0, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'READ'})
     info.image(2, 'RG32F', 'FLOAT_2D', "accum", qualifiers={'READ', 'WRITE'})
-    info.compute_source(glsl_source("octahedral.glsl", "bake_gather.comp"))
+    if falloff is None:
+        for k in range(views):
+            info.sampler(k, 'FLOAT_2D', f"depth_tex{k}")
+    else:
+        assert views == 1
+        info.define("MAX_DISTANCE", "1")
+        info.define("LAYERS", str(LAYERS))
+        if falloff == "wendland":
+            info.define("WENDLAND_FALLOFF", "1")
+        info.image(3, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ'})
+        info.image(4, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ'})
+        info.push_constant('FLOAT', "max_distance")
+    info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_gather.comp"))
     return info
 
 
-def gather_shader(uniform: bool, views: int = 1, shading: bool = False) -> "gpu.types.GPUShader":
+def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None
+                  ) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to VIEWS_PER_DISPATCH) directions per dispatch; shading:
-    entries carry shading normals (plan.smooth_shading)."""
-    return cached_shader(("bake_gather", uniform, views, shading), lambda: _gather_info(uniform, views, shading))
+    entries carry shading normals (plan.smooth_shading); falloff: see _gather_info."""
+    return cached_shader(("bake_gather", uniform, views, shading, falloff),
+                         lambda: _gather_info(uniform, views, shading, falloff))
 
 
 class GatherBaker(LightViewBaker):
@@ -148,19 +168,30 @@ class GatherBaker(LightViewBaker):
         the UV-space target of the list pass, and the view depth."""
         side = plan.max_view_side
         entries = plan.settings.size**2 * plan.settings.sample_count
-        return entries * (ENTRY_BYTES + 1) + side * side * (1 + 4 * views_per_dispatch(plan))
+        per_pixel = 1 + (4 + 4 * LAYERS if plan.settings.max_distance > 0.0 else 4 * views_per_dispatch(plan))
+        return entries * (ENTRY_BYTES + 1) + side * side * per_pixel
 
     def _allocate(self) -> None:
         plan = self.plan
-        if plan.settings.max_distance > 0.0:
-            raise ValueError("the gather baseline supports only unlimited distance")
         side = plan.max_view_side
-        # One depth map per direction of a dispatch; they share the (never written) colour target.
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
-        self.depths = [gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
-                       for _ in range(views_per_dispatch(plan))]
-        self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
-                          for depth in self.depths]
+        self.layered = plan.settings.max_distance > 0.0
+        self.slots = views_per_dispatch(plan)
+        if self.layered:
+            # Max distance: the occluder nearest to each receiver, from per-pixel depth lists.
+            self.layer_count = gpu.types.GPUTexture((side, side), format='R32UI')
+            self.layer_depth = gpu.types.GPUTexture((side, side, LAYERS), format='R32UI')
+            self.overflow = gpu.types.GPUTexture((1, 1), format='R32UI')
+            self.overflow.clear(format='UINT', value=(0,))
+            self.layers_fb = gpu.types.GPUFrameBuffer(color_slots=self.dummy)
+            self.depths, self.depth_fbs = [], []
+        else:
+            # One depth map per direction of a dispatch; they share the (never written) colour target.
+            self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
+            self.depths = [gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
+                           for _ in range(self.slots)]
+            self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
+                              for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
         # GatherViews: one buffer per bake, rewritten before each dispatch.
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
@@ -173,7 +204,8 @@ class GatherBaker(LightViewBaker):
         self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0,
                           texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
-                          views_per_dispatch=len(self.depths), texel_tests=0, texel_tests_skipped=0,
+                          views_per_dispatch=self.slots, texel_tests=0, texel_tests_skipped=0,
+                          layered=self.layered, layer_overflow_pixels=0,
                           shading_normals=self.plan.smooth_shading)
 
     def _draw_order(self) -> np.ndarray | None:
@@ -308,6 +340,7 @@ class GatherBaker(LightViewBaker):
 
     def _release(self) -> None:
         self.depths = self.depth_fbs = self.dummy = self.views_block = None
+        self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
         self.pending = []
         self.chunks = None
         self.entry_position = self.entry_normal = self.entry_texel = self.accum = None
@@ -323,6 +356,16 @@ class GatherBaker(LightViewBaker):
         # map is the same as from every face. Ignoring back faces: a ray from a texel meets the
         # back of exactly the faces that look towards the light, so those are left out.
         runs: list[tuple[int, int]] = []
+        if self.layered:  # every surface on the way counts: all faces into the lists
+            with util.scoped_state():
+                gpu.state.blend_set('NONE')
+                layers_prepass(self.layers_fb, self.all_batch, view, 'FRONT' if plan.settings.ignore_back_faces
+                               else 'NONE', self.layer_count, self.layer_depth, self.overflow)
+            self.pending.append(view)
+            self._test_pending_views()
+            self.stats["view_pixels"] += view.width * view.height
+            self.stats["directions_done"] += 1
+            return
         if plan.settings.ignore_back_faces:
             culling = 'FRONT'
         elif self.chunks is None:
@@ -339,7 +382,7 @@ class GatherBaker(LightViewBaker):
             gpu.state.blend_set('NONE')
             depth_prepass(self.depth_fbs[slot], self.all_batch, view, culling, runs)
         self.pending.append(view)
-        if len(self.pending) == len(self.depths) or index == plan.settings.directions - 1:
+        if len(self.pending) == self.slots or index == plan.settings.directions - 1:
             self._test_pending_views()
         self.stats["view_pixels"] += view.width * view.height
         self.stats["directions_done"] += 1
@@ -354,13 +397,21 @@ class GatherBaker(LightViewBaker):
         for k, view in enumerate(views):
             block["view_proj"][k] = view.matrix.T  # column-major for GLSL
             block["omega"][k] = (*view.omega, 0.0)
-            block["view_info"][k] = (view.width, view.height, view.pixel_size / (view.depth_far - view.depth_near), 0.0)
+            span = view.depth_far - view.depth_near
+            block["view_info"][k] = (view.width, view.height, view.pixel_size / span, span)
         self.views_block.update(self.views_data.view(np.float32))
-        shader = gather_shader(self.plan.settings.weighting == "uniform", len(views), self.shading_layout)
+        settings = self.plan.settings
+        shader = gather_shader(settings.weighting == "uniform", len(views), self.shading_layout,
+                               settings.falloff if self.layered else None)
         shader.bind()
         shader.uniform_block("views", self.views_block)
-        for k in range(len(views)):
-            shader.uniform_sampler(f"depth_tex{k}", self.depths[k])
+        if self.layered:
+            shader.image("layer_count", self.layer_count)
+            shader.image("layer_depth", self.layer_depth)
+            shader.uniform_float("max_distance", self.plan.max_distance_normalized)
+        else:
+            for k in range(len(views)):
+                shader.uniform_sampler(f"depth_tex{k}", self.depths[k])
         shader.image("entry_position", self.entry_position)
         shader.image("entry_normal", self.entry_normal)
         shader.image("accum", self.accum)
@@ -381,6 +432,8 @@ class GatherBaker(LightViewBaker):
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
         """(numerator, denominator), each (size, size) float64: the entries summed per texel."""
         self._test_pending_views()  # directions of a bake stopped short of its last one
+        if self.layered:  # pixels whose depth list overflowed, counted over the whole bake
+            self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
         size = self.plan.settings.size
         n = self.entry_count
         if n == 0:

@@ -27,7 +27,8 @@ import numpy as np
 from ..core.errors import BakeInputError
 from ..core.bake.plan import BakePlan
 from . import util
-from .light_view import RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, soup_shader_info
+from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
+                         soup_shader_info)
 from .shaders import cached_shader, glsl_source
 
 CHUNK_DIRECTIONS = 16
@@ -35,23 +36,10 @@ CHUNK_TARGET = 2.0**12  # expected denominator per texel per chunk, in fixed-poi
 # Depth agreement between the two passes (NDC depth in [0, 1]; the depth range spans a few
 # normalized units, so this is ~1e-6 of the scene's radius).
 DEPTH_TOLERANCE = 2.0**-21
-# Depth layers kept per light-view pixel for max-distance bakes. A ray through a closed mesh
-# crosses an even number of surfaces; 16 holds eight nested shells. Overflow is counted.
-LAYERS = 16
 # Largest split of one pixel's UV footprint per axis (8 x 8 sub-splats). Texels more than
 # 12 times smaller than a light-view pixel per side may then get no sample in a direction;
 # their coverage drops and seam repair treats them as rim texels.
 MAX_FOOTPRINT = 8
-
-
-def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
-    info = soup_shader_info("bake_layers", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
-    info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
-    info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
-    info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
-    info.define("LAYERS", str(LAYERS))
-    info.fragment_source(glsl_source("bake_layers.frag"))
-    return info
 
 
 def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
@@ -76,12 +64,9 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
         info.sampler(0, 'FLOAT_2D', "depth_tex")
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
-    info.fragment_source("layout(early_fragment_tests) in;\n" + glsl_source("bake_common.glsl", "bake_splat.frag"))
+    info.fragment_source("layout(early_fragment_tests) in;\n" + glsl_source("bake_common.glsl", "bake_falloff.glsl",
+                                                                            "bake_splat.frag"))
     return info
-
-
-def layers_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("bake_layers", LAYERS), _layers_info)
 
 
 def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
@@ -130,7 +115,6 @@ class ScatterBaker(LightViewBaker):
             self.layer_depth = gpu.types.GPUTexture((side, side, LAYERS), format='R32UI')
             self.overflow = gpu.types.GPUTexture((1, 1), format='R32UI')
             self.overflow.clear(format='UINT', value=(0,))
-            self.prepass_prog = layers_shader()
             self.depth = self.depth_fb = None
         else:
             self.depth = gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
@@ -168,16 +152,8 @@ class ScatterBaker(LightViewBaker):
         with util.scoped_state():
             gpu.state.blend_set('NONE')
             if self.layered:
-                self.layer_count.clear(format='UINT', value=(0,))
-                with self.splat_fb.bind():
-                    util.set_overlay_pass_state(w, h, culling)
-                    shader = self.prepass_prog
-                    bind_light_view(shader, view, plan.settings.size, prepass=True)
-                    shader.image("layer_count", self.layer_count)
-                    shader.image("layer_depth", self.layer_depth)
-                    shader.image("overflow", self.overflow)
-                    self.all_batch.draw(shader)
-                util.image_barrier()  # the splat pass reads the lists with imageLoad
+                layers_prepass(self.splat_fb, self.all_batch, view, culling, self.layer_count, self.layer_depth,
+                               self.overflow)
             else:
                 depth_prepass(self.depth_fb, self.all_batch, view, prepass_culling)
             with self.splat_fb.bind():

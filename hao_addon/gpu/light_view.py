@@ -40,6 +40,42 @@ RASTER_VARYINGS = (('smooth', 'VEC2', "uv_texel"), ('smooth', 'VEC4', "face_data
                    ('smooth', 'FLOAT', "above_fraction"))
 
 
+# Depth layers kept per light-view pixel for max-distance bakes. A ray through a closed mesh
+# crosses an even number of surfaces; 16 holds eight nested shells. Overflow is counted.
+LAYERS = 16
+
+
+def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = soup_shader_info("bake_layers", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
+    info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
+    info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+    info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
+    info.define("LAYERS", str(LAYERS))
+    info.fragment_source(glsl_source("bake_layers.frag"))
+    return info
+
+
+def layers_shader() -> "gpu.types.GPUShader":
+    return cached_shader(("bake_layers", LAYERS), _layers_info)
+
+
+def layers_prepass(framebuffer, batch, view: OrthoView, culling: str, count, depth, overflow) -> None:
+    """The depth of every fragment of `batch` into per-pixel lists (count (side, side) and
+    depth (side, side, LAYERS) R32UI images; overflow counts pixels with more than LAYERS):
+    what max-distance bakes search for the occluder nearest to a receiver. Call inside
+    util.scoped_state(); the lists are ready for imageLoad when it returns."""
+    count.clear(format='UINT', value=(0,))
+    with framebuffer.bind():
+        util.set_overlay_pass_state(view.width, view.height, culling)
+        shader = layers_shader()
+        bind_light_view(shader, view, 0, prepass=True)
+        shader.image("layer_count", count)
+        shader.image("layer_depth", depth)
+        shader.image("overflow", overflow)
+        batch.draw(shader)
+    util.image_barrier()
+
+
 def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
     info = soup_shader_info("bake_depth", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
     info.fragment_source(glsl_source("bake_depth.frag"))

@@ -175,13 +175,23 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
-    if high_to_low is not None:  # the receivers lie on the sources
-        flat = np.concatenate([flat, *(s.positions.reshape(-1, 3) for s in high_to_low.sources)])
     centre, radius = bounding_sphere(flat)
     scale = radius if radius > 0.0 else 1.0
     t_pos = (target.positions - centre) / scale
+    directions = bake_directions(settings.directions, settings.seed)
 
-    # Occluders that cannot reach the target within max_distance are never drawn.
+    # Selected to Active: the receivers are the sources' points the texels project to.
+    projected, projection_stats = None, {}
+    extent = 1.0  # radius of the receivers' sphere about the origin, normalized
+    if high_to_low is not None:
+        projected, projection_stats, warning = projected_receivers(target, high_to_low, settings, directions,
+                                                                   centre, scale)
+        uv_warnings = uv_warnings + ([warning] if warning else [])
+        if len(projected):
+            extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))
+            flat = np.concatenate([flat, projected.points * scale + centre])
+
+    # Occluders that cannot reach the receivers within max_distance are never drawn.
     if settings.max_distance > 0.0 and occluders:
         lo_t, hi_t = column_bounds(flat)
     occ_parts, culled_objects, culled_faces, drawn_objects = [], 0, 0, 0
@@ -203,7 +213,6 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
     o_normals, _ = face_normals_areas(o_pos)
 
-    directions = bake_directions(settings.directions, settings.seed)
     s_f = face_normalizers(normals, directions, settings.weighting)
     # Faces no direction sees, and zero-area faces (no surface), contribute nothing.
     inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
@@ -219,9 +228,11 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
     density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
     # The scatter's anti-aliasing: that many times more light-view pixels per texel.
-    scatter_samples = settings.view_samples * (settings.sample_count if settings.resolved_method == "scatter" else 1)
+    scatter = settings.method_for(high_to_low is not None) == "scatter"
+    scatter_samples = settings.view_samples * (settings.sample_count if scatter else 1)
     pixel_size = float(np.sqrt(density / scatter_samples))
-    pixel_size = max(pixel_size, 2.0 / (MAX_VIEW_SIDE - 4))  # the target sphere has diameter 2
+    # The receivers' sphere has diameter 2 (the target's), or 2 extent in Selected to Active.
+    pixel_size = max(pixel_size, 2.0 * extent / (MAX_VIEW_SIDE - 4))
 
     # Fraction of the texels (UV area, not surface area: a small dense region can hold many
     # texels) that are FOOTPRINT_SPLIT times smaller than a pixel per side.
@@ -229,11 +240,6 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     uv_used = uv_area[useful]
     dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
-    projected, projection_stats = None, {}
-    if high_to_low is not None:
-        projected, projection_stats, warning = projected_receivers(target, high_to_low, settings, directions,
-                                                                   centre, scale)
-        uv_warnings = uv_warnings + ([warning] if warning else [])
     drawn_parts = [o_pos.reshape(-1, 3)] if projected is not None else [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)]
     drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
@@ -260,7 +266,7 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
-                    pixel_size, int(np.ceil(2.0 / pixel_size)) + 4, target_points, drawn_sphere,
+                    pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
                     closed, holes, projected, stats)

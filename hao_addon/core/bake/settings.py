@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from ..errors import BakeInputError
 from ..setting_spec import Choice, setting, validate
 
 MAX_DIRECTIONS = 65536
@@ -28,11 +27,11 @@ NORMALS_CHOICES = (
     Choice("face", "Face", "flat: every texel uses its triangle's normal"),
 )
 METHOD_CHOICES = (
-    Choice("auto", "Auto", "the gather for unlimited distance (fastest at equal error in the benchmark), "
-                           "the scatter with a max distance"),
+    Choice("auto", "Auto", "the gather for unlimited distance and Selected to Active (fastest at equal error in "
+                           "the benchmark), the scatter with a max distance"),
     Choice("scatter", "Histogram Scatter", "McGraw & Sowers: texel-area average; supports max distance and falloff"),
-    Choice("gather", "Shadow-Map Gather", "shadow maps sampled at texel centres (the paper's baseline); "
-                                          "unlimited distance only"),
+    Choice("gather", "Shadow-Map Gather", "shadow maps sampled at texel centres (the paper's baseline); with a "
+                                          "max distance, per-pixel depth lists"),
     Choice("reference", "Reference (CPU)", "the same estimator ray traced on the CPU: slow (minutes), "
                                            "for checking a GPU bake"),
 )
@@ -93,17 +92,21 @@ class BakeSettings:
     def validated(self) -> "BakeSettings":
         """Return self, or raise SettingError / BakeInputError with a message a user can act on."""
         validate(self)
-        if self.method == "gather" and self.max_distance > 0.0:
-            raise BakeInputError("the gather (shadow-map) baseline supports only unlimited distance: "
-                                 "a depth map keeps the occluder nearest the light, not the one nearest the texel")
         return self
 
     @property
     def resolved_method(self) -> str:
-        """The bake variant that runs: 'auto' picks by the max distance."""
+        """The bake variant that runs on the target's own surface: 'auto' picks by the max
+        distance (see method_for)."""
+        return self.method_for(high_to_low=False)
+
+    def method_for(self, high_to_low: bool) -> str:
+        """The bake variant that runs: 'auto' is the gather, except with a max distance on the
+        target's own surface, where the scatter is (the benchmark's fastest at equal error);
+        Selected to Active always gathers (the scatter cannot bake it)."""
         if self.method != "auto":
             return self.method
-        return "scatter" if self.max_distance > 0.0 else "gather"
+        return "scatter" if self.max_distance > 0.0 and not high_to_low else "gather"
 
     @property
     def sample_count(self) -> int:
