@@ -84,10 +84,8 @@ class ScatterBaker(LightViewBaker):
         """Also refuse Selected to Active: the scatter rasterizes the target's own triangles,
         and high-poly points projected onto its texels are no triangles it could draw."""
         if plan.projected is not None:
-            other = ("the gather (Shadow-Map Gather)" if plan.settings.max_distance == 0.0 else
-                     "the reference method, or the gather with unlimited max distance")
-            raise BakeInputError(f"the histogram scatter cannot bake Selected to Active (it draws the target's own "
-                                 f"surface); use {other}")
+            raise BakeInputError("the histogram scatter cannot bake Selected to Active (it draws the target's own "
+                                 "surface); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
         super().check_limits(plan)
 
     @staticmethod
