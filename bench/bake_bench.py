@@ -234,14 +234,14 @@ def plot(results, path):
     rows = -(-count // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(6 * cols, 4.8 * rows), squeeze=False)
     axes = axes.ravel()
-    styles = {"scatter": ("o-", "HAO scatter (McGraw & Sowers)"), "gather": ("s-", "HAO shadow-map gather"),
-              "cycles": ("^-", "Cycles AO bake (CPU)")}
+    styles = {"scatter": ("o-", "C0", "HAO scatter (McGraw & Sowers)"), "gather": ("s-", "C1", "HAO shadow-map gather"),
+              "cycles": ("^-", "C2", "Cycles AO bake (CPU)")}
     for ax, (title, m, ylabel) in zip(axes, panels):
-        for key, (style, label) in styles.items():
+        for key, (style, color, label) in styles.items():
             runs = m["runs"].get(key)
             if not runs:
                 continue
-            ax.loglog([r["seconds"] for r in runs], [r["rmse"] for r in runs], style, label=label)
+            ax.loglog([r["seconds"] for r in runs], [r["rmse"] for r in runs], style, color=color, label=label)
             for r in runs:
                 ax.annotate(str(r.get("directions", r.get("samples"))), (r["seconds"], r["rmse"]), fontsize=7,
                             textcoords="offset points", xytext=(3, 3))
