@@ -96,14 +96,17 @@ def project(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, 
     bvh = BVHTree.FromPolygons(verts, np.arange(len(verts)).reshape(-1, 3).tolist(), all_triangles=True, epsilon=0.0)
     reach = max_ray_distance if max_ray_distance > 0.0 else 1e30
     ray_cast = bvh.ray_cast
-    face = np.full(len(origins), -1, np.int64)
-    points = np.zeros((len(origins), 3))
     usable = np.flatnonzero(np.abs(directions).sum(axis=1) > 0.0)
-    for i, o, d in zip(usable.tolist(), origins[usable].tolist(), directions[usable].tolist()):
-        loc, _n, idx, _dist = ray_cast(o, d, reach)
-        if idx is not None:
-            face[i] = idx
-            points[i] = loc
+    # Only the casts run per ray in Python; each hit's face index and distance are gathered
+    # into arrays afterwards and the point is origin + distance * direction (storing each hit
+    # Vector into a numpy row cost about as much as the cast itself).
+    cast = [ray_cast(o, d, reach) for o, d in zip(origins[usable].tolist(), directions[usable].tolist())]
+    index = np.array([-1 if c[2] is None else c[2] for c in cast], np.int64)
+    distance = np.array([0.0 if c[3] is None else c[3] for c in cast])
+    face = np.full(len(origins), -1, np.int64)
+    face[usable] = index
+    points = origins.copy()
+    points[usable] += directions[usable] * distance[:, None]
     hit = face >= 0
     bary = np.zeros((len(origins), 3))
     bary[hit] = barycentric(points[hit], triangles[face[hit]])
@@ -150,8 +153,9 @@ def projected_receivers(target: TriangleSoup, request: HighToLow, settings: Bake
     points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
     inv_s = exact_inverse_normalizers(shading, directions, settings.weighting)
     receivers = Receivers(points, geometric, shading, inv_s, texel[hit])
-    sampled = len(np.unique(texel))
-    missed = sampled - len(np.unique(receivers.texel))
+    cells = settings.size * settings.size
+    sampled = int((np.bincount(texel, minlength=cells) > 0).sum())
+    missed = sampled - int((np.bincount(receivers.texel, minlength=cells) > 0).sum())
     warning = None
     if sampled and missed > MISSED_TEXELS_WARNING * sampled:
         warning = (f"{missed} of {sampled} texels of '{target.name}' ({100.0 * missed / sampled:.1f} %) found no "
