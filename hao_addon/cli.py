@@ -181,8 +181,8 @@ def pick_high_poly(specs: list[str]) -> list:
             continue
         obj = bpy.data.objects.get(spec)
         if obj is None or obj.type != 'MESH':
-            meshes = ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
-            raise CLIError(f"--high-poly '{spec}' is neither a mesh file nor a mesh in the input (meshes: {meshes})")
+            raise CLIError(f"--high-poly '{spec}' is neither a mesh file nor a mesh in the input "
+                           f"(meshes: {_mesh_names()})")
         out.append(obj)
     return out
 
@@ -192,21 +192,27 @@ def pick_mesh(name: str, option: str):
 
     obj = bpy.data.objects.get(name)
     if obj is None or obj.type != 'MESH':
-        meshes = ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
-        raise CLIError(f"{option}: no mesh object named '{name}' (meshes: {meshes})")
+        raise CLIError(f"{option}: no mesh object named '{name}' (meshes: {_mesh_names()})")
     return obj
+
+
+def _mesh_names() -> str:
+    """The scene's mesh objects, for messages that name a missing one."""
+    import bpy
+
+    return ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
 
 
 def pick_target(name: str, exclude: tuple = ()):
     """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
     import bpy
 
-    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
     if name:
         obj = bpy.data.objects.get(name)
         if obj is None or obj.type != 'MESH':
-            raise CLIError(f"no mesh object named '{name}' (meshes: {', '.join(o.name for o in meshes) or 'none'})")
+            raise CLIError(f"no mesh object named '{name}' (meshes: {_mesh_names()})")
         return obj
+    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
     if not meshes:
         raise CLIError("the input contains no mesh object")
     return max(meshes, key=lambda o: len(o.data.polygons))

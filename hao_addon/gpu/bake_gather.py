@@ -12,8 +12,8 @@ receiver's nearest occluder towards the light is the deepest entry in front of i
 
 The target is rasterized in UV space once per bake, into a compact texel list (surface point,
 face, texel of every covered texel centre), or a CPU receiver list is uploaded as that list,
-and the directions' tests are compute passes over it. Rasterizing the target in UV space again for every direction gives the same
-fragments, but on llvmpipe a draw's per-triangle cost (about 0.25 us, even for triangles
+and the directions' tests are compute passes over it. Rasterizing the target in UV space
+again for every direction gives the same fragments, but on llvmpipe a draw's per-triangle cost (about 0.25 us, even for triangles
 that are clipped away) made it half of each direction's time on a 70k-triangle mesh.
 The list is stored by normal bin, and each dispatch tests up to four nearby directions over the
 bins that can face them (core/bake/normal_bins.py).
@@ -28,7 +28,7 @@ from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, octahedral_coords, proximity_order
 from ..core.errors import BakeInputError
 from ..core.bake.plan import BakePlan
-from ..core.bake.receivers import Receivers, uv_receivers
+from ..core.bake.receivers import Receivers
 from . import util
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch
 from .shaders import cached_shader, glsl_source
@@ -99,12 +99,9 @@ GPU_TEXEL_LIST = True
 
 def cpu_receivers(plan: BakePlan) -> Receivers | None:
     """The receivers the gather uploads, or None where its GPU raster lists them."""
-    if plan.projected is not None:
-        return plan.projected
-    if plan.settings.sample_count == 1 and GPU_TEXEL_LIST:
+    if plan.projected is None and plan.settings.sample_count == 1 and GPU_TEXEL_LIST:
         return None
-    return uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
-                        plan.settings.size, plan.settings.sample_count)
+    return plan.receivers()
 
 
 def views_per_dispatch(plan: BakePlan) -> int:
@@ -350,42 +347,36 @@ class GatherBaker(LightViewBaker):
     def run_direction(self, index: int) -> None:
         plan = self.plan
         view = self.view(index)
-        # The map must hold the nearest surface along each pixel's ray. Where everything drawn
-        # bounds solids (plan.holes is not None), that is a light-facing face except where the
-        # light looks into a hole: averted faces are drawn only in the chunks there, and the
-        # map is the same as from every face. Ignoring back faces: a ray from a texel meets the
-        # back of exactly the faces that look towards the light, so those are left out.
-        runs: list[tuple[int, int]] = []
-        if self.layered:  # every surface on the way counts: all faces into the lists
-            with util.scoped_state():
-                gpu.state.blend_set('NONE')
-                layers_prepass(self.layers_fb, self.all_batch, view, 'FRONT' if plan.settings.ignore_back_faces
-                               else 'NONE', self.layer_count, self.layer_depth, self.overflow)
-            self.pending.append(view)
-            self._test_pending_views()
-            self.stats["view_pixels"] += view.width * view.height
-            self.stats["directions_done"] += 1
-            return
-        if plan.settings.ignore_back_faces:
-            culling = 'FRONT'
-        elif self.chunks is None:
-            culling = 'NONE'
-        else:
-            culling = 'BACK'
-            faces = len(self.chunks.order)
-            runs = self.hole_runs[index]
-            drawn = sum(count for _, count in runs)
-            self.stats["averted_faces_drawn"] += drawn
-            self.stats["averted_faces_skipped"] += faces - drawn
-        slot = len(self.pending)
         with util.scoped_state():
             gpu.state.blend_set('NONE')
-            depth_prepass(self.depth_fbs[slot], self.all_batch, view, culling, runs)
+            if self.layered:  # every surface on the way counts: all faces into the lists
+                layers_prepass(self.layers_fb, self.all_batch, view, 'FRONT' if plan.settings.ignore_back_faces
+                               else 'NONE', self.layer_count, self.layer_depth, self.overflow)
+            else:
+                culling, runs = self._depth_map_faces(index)
+                depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs)
         self.pending.append(view)
         if len(self.pending) == self.slots or index == plan.settings.directions - 1:
             self._test_pending_views()
         self.stats["view_pixels"] += view.width * view.height
         self.stats["directions_done"] += 1
+
+    def _depth_map_faces(self, index: int) -> tuple[str, list[tuple[int, int]]]:
+        """(culling, averted face runs) of direction `index`'s depth map. The map must hold the
+        nearest surface along each pixel's ray. Where everything drawn bounds solids
+        (plan.holes is not None), that is a light-facing face except where the light looks
+        into a hole: averted faces are drawn only in the chunks there, and the map is the same
+        as from every face. Ignoring back faces: a ray from a texel meets the back of exactly
+        the faces that look towards the light, so those are left out."""
+        if self.plan.settings.ignore_back_faces:
+            return 'FRONT', []
+        if self.chunks is None:
+            return 'NONE', []
+        runs = self.hole_runs[index]
+        drawn = sum(count for _, count in runs)
+        self.stats["averted_faces_drawn"] += drawn
+        self.stats["averted_faces_skipped"] += len(self.chunks.order) - drawn
+        return 'BACK', runs
 
     def _test_pending_views(self) -> None:
         """One compute pass tests every texel-list entry against the pending views' depth maps."""

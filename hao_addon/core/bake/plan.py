@@ -17,7 +17,7 @@ from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_sha
                         surface_holes, uv_areas, weld)
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, check_high_to_low, projected_receivers
-from .receivers import Receivers
+from .receivers import Receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
 from .views import OrthoView, cell_corners, fit_views
@@ -75,6 +75,14 @@ class BakePlan:
     # (core/bake/projection.py); the target itself is then neither a receiver nor drawn.
     projected: Receivers | None = None
     stats: dict = field(default_factory=dict)
+
+    def receivers(self) -> Receivers:
+        """The bake's receivers: the projected high-poly points, or the sample points of the
+        target's own UV layout (samples_per_texel of them per texel)."""
+        if self.projected is not None:
+            return self.projected
+        return uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
+                            self.settings.size, self.settings.sample_count)
 
     @property
     def target_drawn(self) -> bool:

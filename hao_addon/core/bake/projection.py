@@ -146,10 +146,12 @@ def projected_receivers(target: TriangleSoup, request: HighToLow, settings: Bake
     hit = hit_face >= 0
     hf, hb = hit_face[hit], hit_bary[hit]
     mesh = settings.normals == "mesh"
-    corners = np.concatenate([corner_shading_normals(s.positions, s.normals if mesh else None,
-                                                     face_normals_areas(s.positions)[0])[0] for s in request.sources])
+    face_normals, _ = face_normals_areas(triangles)
+    starts = np.cumsum([0] + [s.face_count for s in request.sources])
+    corners = np.concatenate([corner_shading_normals(s.positions, s.normals if mesh else None, face_normals[a:b])[0]
+                              for s, a, b in zip(request.sources, starts[:-1], starts[1:])])
     shading = interpolate_unit(corners, hf, hb)
-    geometric = face_normals_areas(triangles)[0][hf]
+    geometric = face_normals[hf]
     points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
     inv_s = exact_inverse_normalizers(shading, directions, settings.weighting)
     receivers = Receivers(points, geometric, shading, inv_s, texel[hit])

@@ -22,7 +22,6 @@ from ..kernels import occlusion_weight
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from ..reference import build_bvh, first_hit, ray_offset
-from .receivers import uv_receivers
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
 # minutes, which nobody asks for by accident.
@@ -51,10 +50,7 @@ class ReferenceBaker:
 
     def __init__(self, plan: BakePlan) -> None:
         self.plan = plan
-        receivers = plan.projected
-        if receivers is None:
-            receivers = uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
-                                     plan.settings.size, plan.settings.sample_count)
+        receivers = plan.receivers()
         receivers = receivers.subset(receivers.inv_s > 0.0)
         self.texel = receivers.texel
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
