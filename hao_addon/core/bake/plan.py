@@ -259,7 +259,7 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     closed = holes == []
     drawn_sphere = bounding_sphere(drawn)
     # Distinct corners: a light view's window is fitted to them (shared corners once); in
-    # Selected to Active the corners of the source triangles that receivers lie on.
+    # Selected to Active the corners of the grid cells that hold receivers (VIEW_FIT_CELL).
     target_points = t_pos.reshape(-1, 3)[target_weld[0]]
     if projected is not None:
         target_points = cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
