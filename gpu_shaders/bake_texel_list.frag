@@ -28,5 +28,9 @@ void main()
   imageStore(entry_normal, slot, vec4(face_data.xyz, 0.0));
 #  endif
   imageStore(entry_texel, slot, uvec4((uint(gl_FragCoord.y) << 16) | uint(gl_FragCoord.x)));
+#  ifdef TERMINATOR_OFFSET
+  imageStore(entry_lift, slot, vec4(smooth_surface_lift(lift_v0, lift_v1, lift_v2, lift_n0, lift_n1, lift_n2,
+                                                        lift_bary, geometric_normal), 0.0));
+#  endif
 #endif
 }

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Bake orchestration shared by the operator, the CLI and the tests.
 
-``bake_steps`` is a generator: it yields the fraction done after each light direction, so the
-modal operator can draw progress and stop between directions (cancel), and ``bake`` simply
-drains it. Nothing here touches Blender data: input and output are numpy.
+``bake_steps`` is a generator: it yields the fraction done after each light direction (and
+during a Selected-to-Active projection, after each step of its rays), so the modal operator
+can draw progress and stop between any two (cancel), and ``bake`` simply drains it.
+Nothing here touches Blender data: input and output are numpy.
 """
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import numpy as np
 
 from .core.geometry import TriangleSoup
 from .core.errors import BakeInputError
-from .core.bake.plan import make_plan
+from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.seams import finalize_map
 from .core.bake.settings import BakeSettings
@@ -33,6 +34,10 @@ class BakeResult:
     filled: np.ndarray
     stats: dict = field(default_factory=dict)
 
+
+# The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
+# the bunny pair at 1024^2: 2.8 s of 7.8 s at 256 directions, of 22 s at 1024).
+PROJECTION_PROGRESS_SHARE = 0.25
 
 _CACHE: "OrderedDict[str, BakeResult]" = OrderedDict()
 _CACHE_SIZE = 8
@@ -77,7 +82,18 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         yield 1.0
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True})
 
-    plan = make_plan(target, occluders, settings, high_to_low)
+    share = PROJECTION_PROGRESS_SHARE if high_to_low is not None else 0.0
+    planning = make_plan_steps(target, occluders, settings, high_to_low)
+    try:
+        while True:
+            try:
+                fraction = next(planning)
+            except StopIteration as stop:
+                plan = stop.value
+                break
+            yield share * fraction
+    finally:
+        planning.close()  # cancelled during the projection: stop it there
     from .bakers import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
     method = settings.method_for(high_to_low is not None)
     baker_cls = baker_for(method)
@@ -87,7 +103,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         count = settings.directions
         for i in range(count):
             baker.run_direction(i)
-            yield (i + 1) / count
+            yield share + (1.0 - share) * (i + 1) / count
         numerator, denominator = baker.accumulated()
         gpu_stats = dict(baker.stats)
     finally:

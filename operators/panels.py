@@ -30,6 +30,9 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.prop(settings, "falloff")
         col.prop(settings, "weighting")
         col.prop(settings, "normals")
+        sub = col.column()
+        sub.active = settings.normals == 'mesh'
+        sub.prop(settings, "terminator_offset")
         col.prop(settings, "ignore_back_faces")
         col.prop(settings, "occluders")
         col.prop(settings, "samples_per_texel")

@@ -20,20 +20,27 @@ DATA = ROOT / "tests" / "data"
 TRUTH_SIZE = 256
 TRUTH_SPP = 1024
 
-# name: (mesh file, shading). Cycles' shadow-terminator geometry offset (a per-object
-# setting, default 0.1) lifts rays that leave near the terminator off the flat facets towards
-# the smooth surface (Hanika 2021); HAO does not model it yet. On smooth meshes it changes
-# little (their normals stay close to the faces'), but on the strongly bent custom normals of
-# spot_custom it makes Cycles 0.037 brighter on average, so that case's truth is baked with
-# the offset off, where the definitions agree (tests/scripts/make_cycles_truths.py).
+# name: (mesh file, shading). Cycles' Shadow Terminator Geometry Offset (a per-object
+# setting, default 0.1) lifts rays that leave near the terminator off the flat facets to the
+# smooth surface the normals describe; HAO models it (core/bake/terminator.py, setting
+# terminator_offset). On the strongly bent custom normals of Spot it makes Cycles 0.037
+# brighter on average, so that shading is baked both ways: spot_custom with the offset off,
+# spot_custom_default with Blender's default.
 CASES = {
     "spot_smooth": (ROOT / "samples" / "spot.obj", "smooth"),
     "rocker_smooth": (DATA / "rocker-arm.obj", "smooth"),
     "fandisk_sharp": (DATA / "fandisk.obj", "sharp"),
     "spot_custom": (ROOT / "samples" / "spot.obj", "custom"),
+    "spot_custom_default": (ROOT / "samples" / "spot.obj", "custom"),
 }
 SHARP_ANGLE = math.radians(30.0)
-NO_TERMINATOR_OFFSET = {"spot_custom"}
+DEFAULT_TERMINATOR_OFFSET = 0.1  # Blender's default of Object.shadow_terminator_geometry_offset
+TERMINATOR_OFFSETS = {"spot_custom": 0.0}
+
+
+def terminator_offset(name: str) -> float:
+    """The case's Shadow Terminator Geometry Offset (Cycles' truth and our bake alike)."""
+    return TERMINATOR_OFFSETS.get(name, DEFAULT_TERMINATOR_OFFSET)
 
 
 def truth_path(name: str) -> Path:
@@ -81,9 +88,9 @@ def build_object(name: str, uvs: np.ndarray) -> bpy.types.Object:
         mesh.normals_split_custom_set_from_vertices(custom_vertex_normals(v, t).tolist())
     mesh.update()
     obj = bpy.data.objects.new(name, mesh)
-    if name in NO_TERMINATOR_OFFSET and hasattr(obj, "shadow_terminator_geometry_offset"):
-        # Only Cycles reads it (the truths were made on 5.2; bpy 4.2 names no such property).
-        obj.shadow_terminator_geometry_offset = 0.0
+    if hasattr(obj, "shadow_terminator_geometry_offset"):
+        # Cycles reads it (the truths were made on 5.2; bpy 4.2 names no such property).
+        obj.shadow_terminator_geometry_offset = terminator_offset(name)
     bpy.context.scene.collection.objects.link(obj)
     return obj
 

@@ -5,8 +5,10 @@ centre of the target against it.
 
 Same interface as ScatterBaker. Differences a user sees: point samples (the texel centre, or
 the sub-texel and Selected-to-Active receivers of core/bake/receivers.py; no area average, no
-stretch correction needed), shadow-map bias (a slope-scaled offset can hide
-contact occlusion thinner than a few light-view pixels). With a max distance each view's
+stretch correction needed), shadow-map resolution (the receiver-plane depth test allows half
+a light-view pixel of depth and a quarter pixel of the receiver plane's slope, so occluders
+thinner than that are missed), Cycles' terminator offset (the scatter ignores it). With a
+max distance each view's
 depth map becomes per-pixel depth lists (the scatter's, light_view.layers_prepass), and a
 receiver's nearest occluder towards the light is the deepest entry in front of it.
 
@@ -38,10 +40,20 @@ from .shaders import cached_shader, glsl_source
 LIST_WIDTH = 4096
 GROUP_SIZE = 64
 ENTRY_BYTES = 16 + 16 + 4 + 8  # position + 1/S_f, normal, texel, (numerator, denominator)
+LIFT_BYTES = 16  # an entry's terminator lift, where the plan lifts (plan.lifts_terminator)
 
 
-def _texel_list_info(fill: bool, shading: bool) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}{int(shading)}")
+def entry_bytes(plan: BakePlan) -> int:
+    return ENTRY_BYTES + (LIFT_BYTES if plan.lifts_terminator else 0)
+
+
+# The texel-list attributes of the terminator lift (plan_batch's lift_corners): the face's
+# corners and their shading normals at every corner, and the corner's barycentric unit vector.
+LIFT_ATTRIBUTES = ("tri_v0", "tri_v1", "tri_v2", "tri_n0", "tri_n1", "tri_n2", "corner_bary")
+
+
+def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}{int(shading)}{int(terminator)}")
     iface.smooth('VEC3', "world_pos")
     iface.smooth('VEC4', "face_data")
     iface.flat('VEC3', "geometric_normal")
@@ -54,6 +66,15 @@ def _texel_list_info(fill: bool, shading: bool) -> "gpu.types.GPUShaderCreateInf
     info.vertex_in(4, 'VEC3', "geometric")
     if shading:
         info.define("SHADING_NORMALS", "1")
+    if terminator:  # each fragment's Cycles terminator lift (gpu_shaders/bake_terminator.glsl)
+        assert shading
+        info.define("TERMINATOR_OFFSET", "1")
+        for k, name in enumerate(LIFT_ATTRIBUTES):
+            info.vertex_in(5 + k, 'VEC3', name)
+            if name == "corner_bary":
+                iface.smooth('VEC3', "lift_bary")
+            else:
+                iface.flat('VEC3', "lift_" + name[4:])
     info.vertex_out(iface)
     info.fragment_out(0, 'VEC4', "list_out")
     info.image(0, 'R32UI', 'UINT_2D', "bin_count", qualifiers={'READ', 'WRITE'})
@@ -65,14 +86,18 @@ def _texel_list_info(fill: bool, shading: bool) -> "gpu.types.GPUShaderCreateInf
         info.image(2, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'WRITE'})
         info.image(3, 'R32UI', 'UINT_2D', "entry_texel", qualifiers={'WRITE'})
         info.image(4, 'R32F', 'FLOAT_2D', "bin_start", qualifiers={'READ'})
+        if terminator:
+            info.image(5, 'RGBA32F', 'FLOAT_2D', "entry_lift", qualifiers={'WRITE'})
     info.vertex_source(glsl_source("bake_texel_list.vert"))
-    info.fragment_source(glsl_source("octahedral.glsl", "bake_texel_list.frag"))
+    info.fragment_source(glsl_source("octahedral.glsl", "bake_terminator.glsl", "bake_texel_list.frag"))
     return info
 
 
-def texel_list_shader(fill: bool, shading: bool = False) -> "gpu.types.GPUShader":
-    """shading: entries carry the shading and the face normal (plan.smooth_shading)."""
-    return cached_shader(("bake_texel_list", fill, shading), lambda: _texel_list_info(fill, shading))
+def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = False) -> "gpu.types.GPUShader":
+    """shading: entries carry the shading and the face normal (plan.smooth_shading);
+    terminator: and their terminator lift (plan.lifts_terminator)."""
+    return cached_shader(("bake_texel_list", fill, shading, terminator),
+                         lambda: _texel_list_info(fill, shading, terminator))
 
 
 # Directions tested per compute dispatch: an entry and its sums are loaded once for all of
@@ -86,8 +111,23 @@ MAX_BATCHED_VIEW_SIDE = 2048
 # used; mat4 columns and vec4s need no padding.
 GATHER_MAX_VIEWS = 4
 GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
+                               ("normal_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
                                ("omega", "<f4", (GATHER_MAX_VIEWS, 4)),
                                ("view_info", "<f4", (GATHER_MAX_VIEWS, 4))])
+# The gather's depth slack (gpu_shaders/bake_gather.comp, plane_lookup): the receiver's own
+# plane is extrapolated to the depth map's pixel centre exactly, and the comparison allows
+# DEPTH_BIAS_PIXELS of depth plus SLOPE_BIAS_PIXELS pixels' worth of that plane's slope, for
+# the neighbouring facets of a curved surface there. Bias against Cycles at 256 directions
+# (Spot smooth / Spot custom normals, offset off / rocker arm): slope slack 0.1: -0.0002 /
+# +0.0007 / -0.0005; 0.25: +0.0000 / +0.0015 / -0.0001; without the slack -0.0035 on the custom
+# normals (neighbouring facets read as occluders); the old slope-scaled bias (1.5 tan + 0.5,
+# no extrapolation, which ignored occluders up to 150 pixels along grazing rays): -0.0010 /
+# +0.0039 on Spot.
+DEPTH_BIAS_PIXELS = 0.5
+SLOPE_BIAS_PIXELS = 0.25
+# A terminator lift (normalized units) shorter than this leaves a ray start on its facet (the
+# reference tracer's self-intersection offset is of the same size).
+MIN_LIFT = 1e-6
 # Dispatch only the entries of normal bins that can face a view (False: every entry; the
 # results are the same, tests/test_bake_analytic.py).
 NORMAL_BINNING = True
@@ -113,16 +153,26 @@ def views_per_dispatch(plan: BakePlan) -> int:
     return VIEWS_PER_DISPATCH
 
 
-def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None) -> "gpu.types.GPUShaderCreateInfo":
+def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool
+                 ) -> "gpu.types.GPUShaderCreateInfo":
     """falloff: None for unlimited distance (depth maps), else the max-distance falloff
-    ('none', 'wendland'), tested against per-pixel depth lists."""
+    ('none', 'wendland'), tested against per-pixel depth lists; terminator: entries carry
+    their terminator lift (image entry_lift)."""
     info = gpu.types.GPUShaderCreateInfo()
     if shading:
         info.define("SHADING_NORMALS", "1")
+    if terminator:
+        assert shading
+        info.define("TERMINATOR_OFFSET", "1")
+        info.define("MIN_LIFT", repr(MIN_LIFT))
+        info.image(5, 'RGBA32F', 'FLOAT_2D', "entry_lift", qualifiers={'READ'})
+        info.push_constant('FLOAT', "terminator_offset")
     info.local_group_size(GROUP_SIZE, 1, 1)
     info.define("LIST_WIDTH", str(LIST_WIDTH))
     info.define("VIEWS", str(views))
     info.define("GATHER_MAX_VIEWS", str(GATHER_MAX_VIEWS))
+    info.define("DEPTH_BIAS_PIXELS", repr(float(DEPTH_BIAS_PIXELS)))
+    info.define("SLOPE_BIAS_PIXELS", repr(float(SLOPE_BIAS_PIXELS)))
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
     info.push_constant('INT', "first_entry")
@@ -144,16 +194,17 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None) 
         info.image(3, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ'})
         info.image(4, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ'})
         info.push_constant('FLOAT', "max_distance")
-    info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_gather.comp"))
+    info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_terminator.glsl",
+                                    "bake_gather.comp"))
     return info
 
 
-def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None
-                  ) -> "gpu.types.GPUShader":
+def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
+                  terminator: bool = False) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to VIEWS_PER_DISPATCH) directions per dispatch; shading:
-    entries carry shading normals (plan.smooth_shading); falloff: see _gather_info."""
-    return cached_shader(("bake_gather", uniform, views, shading, falloff),
-                         lambda: _gather_info(uniform, views, shading, falloff))
+    entries carry shading normals (plan.smooth_shading); falloff, terminator: see _gather_info."""
+    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator),
+                         lambda: _gather_info(uniform, views, shading, falloff, terminator))
 
 
 class GatherBaker(LightViewBaker):
@@ -166,7 +217,7 @@ class GatherBaker(LightViewBaker):
         side = plan.max_view_side
         entries = plan.settings.size**2 * plan.settings.sample_count
         per_pixel = 1 + (4 + 4 * LAYERS if plan.settings.max_distance > 0.0 else 4 * views_per_dispatch(plan))
-        return entries * (ENTRY_BYTES + 1) + side * side * per_pixel
+        return entries * (entry_bytes(plan) + 1) + side * side * per_pixel
 
     def _allocate(self) -> None:
         plan = self.plan
@@ -197,13 +248,14 @@ class GatherBaker(LightViewBaker):
         self.direction_order = proximity_order(plan.directions)
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
+        self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
         self._build_texel_list()
         self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0,
                           texel_list_entries=self.entry_count,
                           averted_faces_drawn=0, averted_faces_skipped=0,
                           views_per_dispatch=self.slots, texel_tests=0, texel_tests_skipped=0,
                           layered=self.layered, layer_overflow_pixels=0,
-                          shading_normals=self.plan.smooth_shading)
+                          shading_normals=self.plan.smooth_shading, terminator_lift=self.lifted)
 
     def _draw_order(self) -> np.ndarray | None:
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
@@ -229,7 +281,7 @@ class GatherBaker(LightViewBaker):
         corners = self.plan.target_corners
         self.bin_axis, self.bin_threshold = bin_cones(corners[..., :3].reshape(-1, 3), np.repeat(bins, 3),
                                                       np.repeat(faces[:, 3] > 0.0, 3))
-        return plan_batch(self.plan, with_occluders=False, face_bins=bins)
+        return plan_batch(self.plan, with_occluders=False, face_bins=bins, lift_corners=self.plan.lifts_terminator)
 
     def _views_fitted(self, indices: list[int], views: list) -> None:
         """Hole runs (core/bake/face_chunks.py) of a batch of views, found together."""
@@ -239,10 +291,10 @@ class GatherBaker(LightViewBaker):
                                           len(self.chunks.order))
             self.hole_runs = dict(zip(indices, runs))
 
-    def _allocate_list(self, count: int, uploaded: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    def _allocate_list(self, count: int, uploaded: tuple[np.ndarray, ...] | None = None) -> None:
         """The list textures for `count` entries (LIST_WIDTH per row) and zeroed sums;
-        uploaded: (position (count, 4), normal (count, 4)) float32 to fill them with (the
-        texel of each entry then stays on the CPU: only accumulated() reads it)."""
+        uploaded: (position (count, 4), normal (count, 4)[, lift (count, 4)]) float32 to fill
+        them with (the texel of each entry then stays on the CPU: only accumulated() reads it)."""
         size = self.plan.settings.size
         self.entry_count = count
         rows = max(1, -(-count // LIST_WIDTH))
@@ -250,19 +302,24 @@ class GatherBaker(LightViewBaker):
             raise BakeInputError(f"{count} covered texels exceed this GPU's texture limit; use a smaller map")
         if count > size * size:  # overlapping UV islands or sub-texel samples: more entries than texels
             util.check_texture_limits(size, self.plan.max_view_side,
-                                      count * ENTRY_BYTES + self.plan.max_view_side**2 * 8)
+                                      count * entry_bytes(self.plan) + self.plan.max_view_side**2 * 8)
         shape = (LIST_WIDTH, rows)
+        self.entry_lift = None
         if uploaded is None:
             self.entry_position = gpu.types.GPUTexture(shape, format='RGBA32F')
             self.entry_normal = gpu.types.GPUTexture(shape, format='RGBA32F')
             self.entry_texel = gpu.types.GPUTexture(shape, format='R32UI')
+            if self.lifted:
+                self.entry_lift = gpu.types.GPUTexture(shape, format='RGBA32F')
         else:
             def texture(values: np.ndarray) -> "gpu.types.GPUTexture":
                 full = np.zeros((rows * LIST_WIDTH, 4), np.float32)
                 full[:count] = values
                 return gpu.types.GPUTexture(shape, format='RGBA32F',
                                             data=gpu.types.Buffer('FLOAT', full.size, full.ravel()))
-            self.entry_position, self.entry_normal = (texture(v) for v in uploaded)
+            self.entry_position, self.entry_normal = (texture(v) for v in uploaded[:2])
+            if len(uploaded) > 2:
+                self.entry_lift = texture(uploaded[2])
         self.accum = gpu.types.GPUTexture(shape, format='RG32F')
         self.accum.clear(format='FLOAT', value=(0.0, 0.0))
 
@@ -279,7 +336,12 @@ class GatherBaker(LightViewBaker):
         normal = np.concatenate([octahedral_coords(receivers.shading[order]),
                                  octahedral_coords(receivers.geometric[order])], axis=1)
         self.entry_texels = receivers.texel[order]
-        self._allocate_list(len(order), (position.astype(np.float32), normal.astype(np.float32)))
+        uploaded = [position.astype(np.float32), normal.astype(np.float32)]
+        if self.lifted:
+            lift = np.zeros((len(order), 4), np.float32)
+            lift[:, :3] = receivers.lift[order]
+            uploaded.append(lift)
+        self._allocate_list(len(order), tuple(uploaded))
 
     def _build_texel_list(self) -> None:
         """Count the target's UV-space fragments per normal bin, allocate the list at that
@@ -304,11 +366,13 @@ class GatherBaker(LightViewBaker):
                     shader.image("entry_normal", self.entry_normal)
                     shader.image("entry_texel", self.entry_texel)
                     shader.image("bin_start", bin_start)
+                    if self.lifted:
+                        shader.image("entry_lift", self.entry_lift)
                 self.target_batch.draw(shader)
             util.image_barrier()
 
-        fill = texel_list_shader(True, self.plan.smooth_shading)
-        draw(texel_list_shader(False, self.plan.smooth_shading))
+        fill = texel_list_shader(True, self.plan.smooth_shading, self.lifted)
+        draw(texel_list_shader(False, self.plan.smooth_shading, self.lifted))
         per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
         count = int(per_bin.sum())
         self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
@@ -340,7 +404,7 @@ class GatherBaker(LightViewBaker):
         self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
         self.pending = []
         self.chunks = None
-        self.entry_position = self.entry_normal = self.entry_texel = self.accum = None
+        self.entry_position = self.entry_normal = self.entry_texel = self.entry_lift = self.accum = None
         self.receivers = self.entry_texels = None
         super()._release()
 
@@ -387,13 +451,14 @@ class GatherBaker(LightViewBaker):
         self.views_data.view(np.float32)[:] = 0.0
         for k, view in enumerate(views):
             block["view_proj"][k] = view.matrix.T  # column-major for GLSL
+            block["normal_proj"][k][:3, :3] = np.linalg.inv(view.matrix[:3, :3])  # (M^-T)^T
             block["omega"][k] = (*view.omega, 0.0)
             span = view.depth_far - view.depth_near
             block["view_info"][k] = (view.width, view.height, view.pixel_size / span, span)
         self.views_block.update(self.views_data.view(np.float32))
         settings = self.plan.settings
         shader = gather_shader(settings.weighting == "uniform", len(views), self.shading_layout,
-                               settings.falloff if self.layered else None)
+                               settings.falloff if self.layered else None, self.lifted)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         if self.layered:
@@ -406,6 +471,9 @@ class GatherBaker(LightViewBaker):
         shader.image("entry_position", self.entry_position)
         shader.image("entry_normal", self.entry_normal)
         shader.image("accum", self.accum)
+        if self.lifted:
+            shader.image("entry_lift", self.entry_lift)
+            shader.uniform_float("terminator_offset", settings.terminator_offset)
         # On llvmpipe an invocation costs its whole shader whether or not its entry faces a
         # view, so entries of bins that face none of these views are not dispatched at all.
         tested = 0

@@ -87,14 +87,16 @@ def depth_shader() -> "gpu.types.GPUShader":
 
 
 def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None,
-               face_bins: np.ndarray | None = None) -> "gpu.types.GPUBatch":
+               face_bins: np.ndarray | None = None, lift_corners: bool = False) -> "gpu.types.GPUBatch":
     """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)
     (plan.drawn_positions: the occluders alone in Selected to Active).
     Attributes "face" and "above" are per corner: the shading normal and 1 / S
     (plan.target_corners) and the above-face fraction (plan.target_above).
     order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
     face normal bins, added as the float attribute "bin" with the face normal as
-    "geometric" (target alone only)."""
+    "geometric" (target alone only); lift_corners: with them, each corner also carries its
+    face's corners and shading normals and its barycentric unit vector (the texel list's
+    terminator lift, bake_gather.LIFT_ATTRIBUTES)."""
     # Selected to Active: the target is not drawn with the occluders (plan.target_drawn).
     ft = len(plan.target_positions) if plan.target_drawn or not with_occluders else 0
     fo = len(plan.occluder_positions) if with_occluders else 0
@@ -112,6 +114,12 @@ def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = 
         assert fo == 0 and order is None
         attrs["bin"] = ('F32', np.repeat(np.asarray(face_bins, np.float32), 3))
         attrs["geometric"] = ('F32', np.repeat(plan.target_faces[:, :3], 3, axis=0))
+        if lift_corners:
+            corners = (plan.target_positions, plan.target_corners[..., :3])
+            for k in range(3):
+                attrs[f"tri_v{k}"] = ('F32', np.repeat(corners[0][:, k], 3, axis=0))
+                attrs[f"tri_n{k}"] = ('F32', np.repeat(corners[1][:, k], 3, axis=0))
+            attrs["corner_bary"] = ('F32', np.tile(np.eye(3, dtype=np.float32), (len(pos), 1)))
     return util.make_batch('TRIS', attrs)
 
 

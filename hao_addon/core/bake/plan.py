@@ -8,6 +8,7 @@ pixel size from the texel density of the UV layout.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Generator
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
 from .normalization import corner_normalizers, face_normalizers
-from .projection import HighToLow, check_high_to_low, projected_receivers
+from .projection import HighToLow, check_high_to_low, drain, projected_receivers_steps
 from .receivers import Receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
@@ -82,7 +83,13 @@ class BakePlan:
         if self.projected is not None:
             return self.projected
         return uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
-                            self.settings.size, self.settings.sample_count)
+                            self.settings.size, self.settings.sample_count, self.lifts_terminator)
+
+    @property
+    def lifts_terminator(self) -> bool:
+        """Whether ray starts near the terminator are lifted to the smooth surface (Cycles'
+        geometry offset, core/bake/terminator.py): smooth shading with the offset on."""
+        return self.smooth_shading and self.settings.terminator_offset > 0.0
 
     @property
     def target_drawn(self) -> bool:
@@ -161,6 +168,13 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
     with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
     and the occluders occlude, the target does not)."""
+    return drain(make_plan_steps(target, occluders, settings, high_to_low))
+
+
+def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+                    high_to_low: HighToLow | None = None) -> Generator[float, None, BakePlan]:
+    """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
+    without high_to_low): its seconds of ray casting can be drawn and cancelled."""
     settings = settings.validated()
     if target.face_count == 0:
         raise BakeInputError(f"'{target.name}' has no faces to bake")
@@ -192,8 +206,8 @@ def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: Bak
     projected, projection_stats = None, {}
     extent = 1.0  # radius of the receivers' sphere about the origin, normalized
     if high_to_low is not None:
-        projected, projection_stats, warning = projected_receivers(target, high_to_low, settings, directions,
-                                                                   centre, scale)
+        projected, projection_stats, warning = yield from projected_receivers_steps(
+            target, high_to_low, settings, directions, centre, scale)
         uv_warnings = uv_warnings + ([warning] if warning else [])
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))

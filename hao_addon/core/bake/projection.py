@@ -11,12 +11,15 @@ As Blender's bake does it (render/intern/bake.cc, RE_bake_pixels_populate_from_o
 - the nearest hit of any source, front or back face, wins; with a max ray distance > 0 a
   hit farther than that from the ray's start is a miss. A sample that misses gets no value.
 One ray per sample, once per bake (mathutils' BVH, about 2 us a ray here; the GPU passes
-then bake the hit points like any other receivers).
+then bake the hit points like any other receivers), in steps of RAYS_PER_STEP rays: the
+*_steps generators yield the fraction cast after each, so a modal bake can draw progress and
+be cancelled during a projection of seconds.
 """
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Generator
 
 import numpy as np
 
@@ -24,6 +27,7 @@ from ..errors import BakeInputError
 from ..geometry import TriangleSoup, corner_shading_normals, face_normals_areas, smooth_vertex_normals
 from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
 from .settings import BakeSettings
+from .terminator import smooth_surface_lift
 
 # Warn when more than this fraction of the sampled texels found no high-poly surface (they
 # are filled from their neighbours, as margin).
@@ -86,10 +90,29 @@ def ray_starts(target: TriangleSoup, request: HighToLow, face: np.ndarray, bary:
     return origins, np.divide(d, length, out=np.zeros_like(d), where=length > 0.0)
 
 
+# Rays cast between two progress steps (about 0.1-0.2 s here).
+RAYS_PER_STEP = 50_000
+
+
+def drain(steps: Generator) -> object:
+    """Run a *_steps generator to its end and return its value."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as stop:
+            return stop.value
+
+
 def project(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, max_ray_distance: float
             ) -> tuple[np.ndarray, np.ndarray]:
     """First hit of each ray on triangles (Fs, 3, 3) (both sides). Returns (face (m,) int64,
     -1 for a miss or a zero direction; bary (m, 3) float64 of the hit point on that face)."""
+    return drain(project_steps(origins, directions, triangles, max_ray_distance))
+
+
+def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, max_ray_distance: float
+                  ) -> Generator[float, None, tuple[np.ndarray, np.ndarray]]:
+    """project(), yielding the fraction of rays cast after every RAYS_PER_STEP of them."""
     from mathutils.bvhtree import BVHTree  # numpy core otherwise; mathutils comes with bpy
 
     verts = triangles.reshape(-1, 3).tolist()
@@ -100,7 +123,11 @@ def project(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, 
     # Only the casts run per ray in Python; each hit's face index and distance are gathered
     # into arrays afterwards and the point is origin + distance * direction (storing each hit
     # Vector into a numpy row cost about as much as the cast itself).
-    cast = [ray_cast(o, d, reach) for o, d in zip(origins[usable].tolist(), directions[usable].tolist())]
+    cast = []
+    for start in range(0, len(usable), RAYS_PER_STEP):
+        chunk = usable[start:start + RAYS_PER_STEP]
+        cast.extend(ray_cast(o, d, reach) for o, d in zip(origins[chunk].tolist(), directions[chunk].tolist()))
+        yield (start + len(chunk)) / len(usable)
     index = np.array([-1 if c[2] is None else c[2] for c in cast], np.int64)
     distance = np.array([0.0 if c[3] is None else c[3] for c in cast])
     face = np.full(len(origins), -1, np.int64)
@@ -133,6 +160,13 @@ def barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, directions: np.ndarray,
                         centre: np.ndarray, scale: float) -> tuple[Receivers, dict, str | None]:
+    """projected_receivers_steps() run to its end."""
+    return drain(projected_receivers_steps(target, request, settings, directions, centre, scale))
+
+
+def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,
+                              directions: np.ndarray, centre: np.ndarray, scale: float
+                              ) -> Generator[float, None, tuple[Receivers, dict, str | None]]:
     """The receivers of a Selected-to-Active bake: the source points the target's texel
     samples project to, with the sources' own shading normals (settings.normals), exact
     1 / S, positions normalized by (centre (3,), scale). Returns them, stats, and a warning
@@ -141,7 +175,7 @@ def projected_receivers(target: TriangleSoup, request: HighToLow, settings: Bake
     origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
     triangles = np.concatenate([s.positions for s in request.sources])
     started = time.perf_counter()
-    hit_face, hit_bary = project(origins, rays, triangles, settings.max_ray_distance)
+    hit_face, hit_bary = yield from project_steps(origins, rays, triangles, settings.max_ray_distance)
     seconds = time.perf_counter() - started
     hit = hit_face >= 0
     hf, hb = hit_face[hit], hit_bary[hit]
@@ -154,7 +188,11 @@ def projected_receivers(target: TriangleSoup, request: HighToLow, settings: Bake
     geometric = face_normals[hf]
     points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
     inv_s = exact_inverse_normalizers(shading, directions, settings.weighting)
-    receivers = Receivers(points, geometric, shading, inv_s, texel[hit])
+    smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
+    lift = None
+    if smooth and settings.terminator_offset > 0.0:  # Cycles lifts the high-poly's ray starts too
+        lift = smooth_surface_lift(triangles[hf], corners[hf].astype(np.float64), hb, geometric) / scale
+    receivers = Receivers(points, geometric, shading, inv_s, texel[hit], lift)
     cells = settings.size * settings.size
     sampled = int((np.bincount(texel, minlength=cells) > 0).sum())
     missed = sampled - int((np.bincount(receivers.texel, minlength=cells) > 0).sum())
@@ -163,7 +201,6 @@ def projected_receivers(target: TriangleSoup, request: HighToLow, settings: Bake
         warning = (f"{missed} of {sampled} texels of '{target.name}' ({100.0 * missed / sampled:.1f} %) found no "
                    f"high-poly surface and were filled from their neighbours: raise the cage extrusion or the max "
                    f"ray distance, or use a cage object")
-    smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
     stats = dict(high_poly_faces=int(len(triangles)), projected_samples=int(len(texel)),
                  missed_samples=int((~hit).sum()), missed_texels=int(missed), projection_seconds=round(seconds, 3),
                  smooth_receivers=smooth)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .normalization import hemisphere_weight
+from .terminator import smooth_surface_lift
 from .uv_raster import texel_surface_samples
 
 
@@ -25,20 +26,23 @@ class Receivers:
     surface (rays start off it, directions below it are occluded); shading: (n, 3) unit
     normals the hemisphere and the cosine weight are about; inv_s: (n,) 1 / S, S the exact
     normalizer of the shading normal (0: never lit, the receiver adds nothing); texel: (n,)
-    int64 flat texel index y * size + x."""
+    int64 flat texel index y * size + x; lift: (n, 3) normalized, Cycles' terminator lift of
+    ray starts at full amount (core/bake/terminator.py), or None where nothing is lifted (flat
+    shading, or the offset off)."""
 
     points: np.ndarray
     geometric: np.ndarray
     shading: np.ndarray
     inv_s: np.ndarray
     texel: np.ndarray
+    lift: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.points)
 
     def subset(self, keep: np.ndarray) -> "Receivers":
         return Receivers(self.points[keep], self.geometric[keep], self.shading[keep], self.inv_s[keep],
-                         self.texel[keep])
+                         self.texel[keep], None if self.lift is None else self.lift[keep])
 
 
 def sub_texel_grid(samples_per_texel: int) -> int:
@@ -84,15 +88,20 @@ def exact_inverse_normalizers(shading: np.ndarray, directions: np.ndarray, weigh
 
 
 def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corners: np.ndarray, size: int,
-                 samples_per_texel: int = 1) -> Receivers:
+                 samples_per_texel: int = 1, lift: bool = False) -> Receivers:
     """The target's own surface at the sample points of its UV layout (BakePlan fields:
     positions (F, 3, 3) normalized, uvs (F, 3, 2), faces (F, 4) normal and 1 / S_f, corners
     (F, 3, 4) shading normal and 1 / S). Faces never lit are left out. 1 / S is interpolated
-    like the GPU passes interpolate it."""
+    like the GPU passes interpolate it. lift: with Cycles' terminator lift of each point."""
     texel, face, bary = texel_sample_points(uvs, size, samples_per_texel)
     lit = faces[face, 3] > 0.0
     texel, face, bary = texel[lit], face[lit], bary[lit]
     points = np.einsum("mk,mkd->md", bary, positions[face].astype(np.float64))
     shading = interpolate_unit(corners[..., :3], face, bary)
     inv_s = np.einsum("mk,mk->m", bary, corners[face, :, 3].astype(np.float64))
-    return Receivers(points, faces[face, :3].astype(np.float64), shading, inv_s, texel)
+    geometric = faces[face, :3].astype(np.float64)
+    lifts = None
+    if lift:
+        lifts = smooth_surface_lift(positions[face].astype(np.float64), corners[face, :, :3].astype(np.float64),
+                                    bary, geometric)
+    return Receivers(points, geometric, shading, inv_s, texel, lifts)

@@ -8,8 +8,10 @@ every bake test runs it on the scenes the GPU passes bake. Receivers are the tex
 of the target's UV layout (as the gather's), their sub-texel samples, or the high-poly
 points of a Selected-to-Active bake (core/bake/receivers.py); per direction each adds (V w, w) with
 w = weight(omega . n_s) / S interpolated like the GPU passes interpolate them, and V the
-visibility: 0 below the true surface (the terminator rule of Cycles' AO pass), else one ray
-towards the light with the plan's max distance, falloff and back-face rule. Slow (a Python
+visibility: one ray towards the light with the plan's max distance, falloff and back-face
+rule, from the receiver or, where Cycles' terminator offset lifts it (core/bake/terminator.py),
+from the lifted point; 0 for a direction below the true surface that is not lifted (such a ray
+would enter the surface, as it does in Cycles' AO pass). Slow (a Python
 call per ray): for tests and for checking a GPU bake, never a silent substitute for one.
 """
 from __future__ import annotations
@@ -21,6 +23,7 @@ from ..errors import BakeInputError
 from ..kernels import occlusion_weight
 from .normalization import hemisphere_weight
 from .plan import BakePlan
+from .terminator import lift_amount
 from ..reference import build_bvh, first_hit, ray_offset
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
@@ -62,29 +65,43 @@ class ReferenceBaker:
         radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
         self.offsets = np.array([ray_offset(p, radius) for p in self.points])
         self.origins = [Vector(p) for p in self.points + self.geometric * self.offsets[:, None]]
+        self.lift = receivers.lift
         self.num = np.zeros(len(self.points))
         self.den = np.zeros(len(self.points))
-        self.stats = dict(receivers=len(self.points), rays_traced=0, rays_below_surface=0, directions_done=0,
-                          shading_normals=plan.smooth_shading)
+        self.stats = dict(receivers=len(self.points), rays_traced=0, rays_lifted=0, rays_below_surface=0,
+                          directions_done=0, shading_normals=plan.smooth_shading)
 
     def run_direction(self, index: int) -> None:
         """Trace direction `index` of the plan from every receiver and add its terms."""
         settings = self.plan.settings
         omega = self.plan.directions[index]
-        weight = hemisphere_weight(self.shading @ omega, settings.weighting) * self.inv_s
-        above = self.geometric @ omega > 0.0
+        cos_shading = self.shading @ omega
+        weight = hemisphere_weight(cos_shading, settings.weighting) * self.inv_s
+        cos_true = self.geometric @ omega
+        above = cos_true > 0.0
         reach = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 1e30
         dists = np.zeros(len(self.points))  # below the true surface: occluded
         ray_cast = self.bvh.ray_cast
-        traced = np.flatnonzero(above & (weight > 0.0))
-        for i in traced:
+        amount = None
+        if self.lift is not None:
+            amount = lift_amount(cos_shading, cos_true, settings.terminator_offset)
+            # A start lifted by less than the self-intersection offset stays on the facet.
+            lifted = (weight > 0.0) & (amount * np.linalg.norm(self.lift, axis=1) > self.offsets)
+        else:
+            lifted = np.zeros(len(self.points), bool)
+        for i in np.flatnonzero(above & (weight > 0.0) & ~lifted):
             dists[i] = first_hit(ray_cast, self.origins[i], omega, reach, self.offsets[i], self.face_normals)
+        for i in np.flatnonzero(lifted):
+            origin = Vector(self.points[i] + self.lift[i] * amount[i])
+            dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals)
         visible = 1.0 - occlusion_weight(dists, self.plan.max_distance_normalized if settings.max_distance > 0.0
                                          else 0.0, settings.falloff)
         self.num += weight * visible
         self.den += weight
-        self.stats["rays_traced"] += len(traced)
-        self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above).sum())
+        traced = (above & (weight > 0.0)) | lifted
+        self.stats["rays_traced"] += int(traced.sum())
+        self.stats["rays_lifted"] += int(lifted.sum())
+        self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above & ~lifted).sum())
         self.stats["directions_done"] += 1
 
     def accumulated(self) -> tuple[np.ndarray, np.ndarray]:

@@ -83,6 +83,11 @@ class BakeSettings:
         0.0, label="Max Ray Distance", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
         description="Selected to Active: a high-poly surface farther than this from the ray start is not found; "
                     "0 = no limit")
+    terminator_offset: float = setting(
+        0.1, label="Terminator Offset", minimum=0.0, maximum=1.0,
+        description="Cycles' Shadow Terminator Geometry Offset (its default 0.1): rays that graze a smooth-shaded "
+                    "facet start from the smooth surface its normals describe, so the triangles do not show as "
+                    "dark bands; 0 = off. The scatter ignores it")
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
