@@ -7,9 +7,8 @@
  * direction per dispatch, and the same on every run. */
 
 /* Receiver-plane depth test: where `position` looks up view k's depth map, and the depth its
- * own plane (normal plane_normal; zero: a point off every surface) has at that pixel's
- * centre, minus the slack of bake_gather.py (DEPTH_BIAS_PIXELS, SLOPE_BIAS_PIXELS). The
- * depth map holds the nearest surface at pixel centres, up to 0.71 pixel beside the
+ * own plane (normal plane_normal) has at that pixel's centre, minus DEPTH_BIAS_PIXELS of
+ * depth and slope_slack pixels' worth of the plane's slope (bake_gather.py). The depth map holds the nearest surface at pixel centres, up to 0.71 pixel beside the
  * receiver; comparing it with the receiver's own plane extrapolated there, instead of
  * with the receiver's depth, needs no slope-scaled bias. That bias (1.5 tan(theta) + 0.5
  * pixels) ignored every occluder within that distance along the ray, up to 150 pixels at
@@ -102,15 +101,15 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
  * (measured against Cycles' default on Spot with custom normals: bias -0.0000; with no plane
  * -0.0006, with the slope slack +0.0005). */
 #ifdef TERMINATOR_OFFSET
+/* One lookup per view whichever case applies: llvmpipe runs both sides of a branch its lanes
+ * disagree on, so two calls would cost two lookups. */
 #  define TERMINATOR_VISIBLE(depth_tex, k, cos_theta, cos_true) \
     float amount = lift_amount(cos_theta, cos_true, terminator_offset); \
-    vec3 origin = position.xyz + lift * amount; \
+    bool above = cos_true > 0.0; \
     float visible = 0.0; \
-    if (cos_true > 0.0) { \
-      visible = VISIBLE_AT(depth_tex, k, origin, geometric, SLOPE_BIAS_PIXELS); \
-    } \
-    else if (amount * lift_length > MIN_LIFT) { \
-      visible = VISIBLE_AT(depth_tex, k, origin, normal, 0.0); \
+    if (above || amount * lift_length > MIN_LIFT) { \
+      visible = VISIBLE_AT(depth_tex, k, position.xyz + lift * amount, above ? geometric : normal, \
+                           above ? SLOPE_BIAS_PIXELS : 0.0); \
     }
 #else
 #  define TERMINATOR_VISIBLE(depth_tex, k, cos_theta, cos_true) \
