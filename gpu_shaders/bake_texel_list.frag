@@ -1,5 +1,6 @@
-/* Appends one entry per fragment (texel centre x face) to the texel list, grouped by the
- * face's normal bin. The count variant counts the entries of each bin, so the list can be
+/* Appends one entry per fragment (texel centre x face) to the texel list, grouped by normal
+ * bin: the face's, or with shading normals the bin of the fragment's own shading normal as
+ * stored (core/bake/normal_bins.py, whose cell cones then bound it). The count variant counts the entries of each bin, so the list can be
  * allocated at its exact size with each bin's range known; the fill variant stores every
  * entry in its bin's range (bin_start holds the ranges' first entries, as float bits).
  * Overlapping UV islands give one entry per island, and their sums average later. Entry
@@ -12,9 +13,16 @@ void main()
   if (face_data.w <= 0.0) {
     return; /* a face no direction sees (or of zero area) contributes nothing */
   }
-  uint index = imageAtomicAdd(bin_count, ivec2(face_bin, 0), 1u);
+#ifdef SHADING_NORMALS
+  vec2 shading_oct = octahedral_encode(normalize(face_data.xyz));
+  ivec2 cell = clamp(ivec2((shading_oct + 1.0) * (0.5 * float(OCT_SIDE))), ivec2(0), ivec2(OCT_SIDE - 1));
+  int entry_bin = cell.y * OCT_SIDE + cell.x;
+#else
+  int entry_bin = face_bin;
+#endif
+  uint index = imageAtomicAdd(bin_count, ivec2(entry_bin, 0), 1u);
 #ifdef FILL
-  index += floatBitsToUint(imageLoad(bin_start, ivec2(face_bin, 0)).r);
+  index += floatBitsToUint(imageLoad(bin_start, ivec2(entry_bin, 0)).r);
   if (index >= uint(capacity)) {
     return;
   }
@@ -23,7 +31,7 @@ void main()
 #  ifdef SHADING_NORMALS
   /* Both normals: the weight is about the shading one, visibility and its bias belong to the
    * true surface. */
-  imageStore(entry_normal, slot, vec4(octahedral_encode(normalize(face_data.xyz)), octahedral_encode(geometric_normal)));
+  imageStore(entry_normal, slot, vec4(shading_oct, octahedral_encode(geometric_normal)));
 #  else
   imageStore(entry_normal, slot, vec4(face_data.xyz, 0.0));
 #  endif

@@ -158,22 +158,33 @@ def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypat
     np.testing.assert_array_equal(maps[0], maps[1])
 
 
-def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, monkeypatch):
-    """Dispatching only the texel-list entries whose normal bin can face a batch's views
-    (core/bake/normal_bins.py) gives the same map as testing every entry, and skips entries."""
+@pytest.mark.parametrize("shading", ["face", "smooth"])
+def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, monkeypatch, shading):
+    """Dispatching only the texel-list entries whose normal bin can face a batch's views, and
+    drawing into the depth maps only the faces of bins that can face the light
+    (core/bake/normal_bins.py), gives the same map as testing every entry and drawing every
+    face, and skips both. Smooth shading bins each entry by its own shading normal (the
+    octahedral cell cones); face shading by its face."""
     import hao_addon.gpu.bake_gather as bake_gather
     sphere = scenes.uv_sphere(1.0, (0.0, 0.0, 1.0), 48, 24)  # normals all round: bins to skip
+    if shading == "smooth":
+        sphere.normals = sphere.positions - np.array([0.0, 0.0, 1.0])
+    # A closed scene (the depth maps cull back faces): the sphere over a box.
+    box = scenes.box((-3.0, -3.0, -1.0), (3.0, 3.0, -0.05))
     settings = BakeSettings(size=64, directions=32, method="gather", margin=0)
     maps, stats = [], []
     for binning in (True, False):
         monkeypatch.setattr(bake_gather, "NORMAL_BINNING", binning)
-        res = bake(sphere, [scenes.grid_plane(8.0, 16)], settings, use_cache=False)
+        res = bake(sphere, [box], settings, use_cache=False)
         maps.append(res.ao)
         stats.append(res.stats)
     np.testing.assert_array_equal(maps[0], maps[1])
-    assert (maps[0] < 0.9).sum() > 50  # the plane shades the sphere's underside
+    assert (maps[0] < 0.9).sum() > 50  # the box shades the sphere's underside
     assert stats[0]["texel_tests_skipped"] > 0.1 * (stats[0]["texel_tests"] + stats[0]["texel_tests_skipped"])
     assert stats[1]["texel_tests_skipped"] == 0
+    # Half the faces of a closed scene face away from each light: about that many are skipped.
+    assert stats[0]["depth_faces_skipped"] > 0.3 * (stats[0]["depth_faces_drawn"] + stats[0]["depth_faces_skipped"])
+    assert stats[1]["depth_faces_skipped"] == stats[1]["depth_faces_drawn"] == 0
 
 
 @pytest.mark.parametrize("method", ["scatter", "gather"])

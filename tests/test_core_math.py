@@ -359,3 +359,58 @@ def test_normal_bin_cones_hold_every_face_a_view_can_face():
         assert needed[bins[facing]].all()
         skipped += (~needed[bins[used]]).sum()
     assert skipped > 0.1 * 16 * used.sum()  # nearby directions per batch: bins are skipped (19 % here)
+
+
+def test_octahedral_cell_cones_hold_every_normal_of_their_cell():
+    """Smooth-shaded gather entries are binned by their own shading normal and skipped by their
+    cell's cone (normal_bins.cell_cones): every unit vector, including those on the cells'
+    edges, the axes and the equator fold, lies within its bin's cone; the cones are narrow."""
+    from hao_addon.core.bake.normal_bins import OCT_SIDE, cell_cones, normal_bins, octahedral_decode
+    rng = np.random.default_rng(5)
+    normals = rng.normal(size=(400_000, 3))
+    # Points on cell edges and on the fold |x| + |y| = 1 of the octahedral map.
+    edge = np.round(rng.uniform(-1, 1, size=(50_000, 2)) * OCT_SIDE / 2) / (OCT_SIDE / 2)
+    free = rng.uniform(-1, 1, size=(50_000, 2))
+    on_edges = np.concatenate([np.stack([edge[:, 0], free[:, 1]], 1), np.stack([free[:, 0], edge[:, 1]], 1)])
+    fold = rng.uniform(-1, 1, size=50_000)
+    on_fold = np.stack([fold, (1.0 - np.abs(fold)) * rng.choice([-1.0, 1.0], 50_000)], 1)
+    normals = np.concatenate([normals / np.linalg.norm(normals, axis=1, keepdims=True), octahedral_decode(on_edges),
+                              octahedral_decode(on_fold), np.eye(3), -np.eye(3)])
+    axis, threshold = cell_cones()
+    cos_half = np.sqrt(1.0 - threshold**2)
+    bins = normal_bins(normals)
+    assert (np.einsum("nd,nd->n", normals, axis[bins]) >= cos_half[bins]).all()
+    assert np.degrees(np.arccos(cos_half)).max() < 16.0  # 16 x 16 cells: at most ~15 degrees
+
+
+def test_face_bins_draw_every_face_turned_towards_the_light():
+    """The gather's depth maps draw only the bins' runs FaceBins.runs gives for the light:
+    every face with n . omega > 0 is in one, and about half the faces are left out."""
+    from hao_addon.core.bake.normal_bins import FaceBins
+    from hao_addon.core.directions import bake_directions
+    rng = np.random.default_rng(3)
+    normals = rng.normal(size=(30_000, 3))
+    normals[:10] = 0.0  # degenerate faces stay in every run
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
+    bins = FaceBins.of(normals)
+    position = np.empty(len(normals), np.int64)
+    position[bins.order] = np.arange(len(normals))
+    left_out = 0
+    for omega in bake_directions(32, 2):
+        drawn = np.zeros(len(normals), bool)
+        for first, end in bins.runs(omega):
+            drawn[first:end] = True
+        assert drawn[position[normals @ omega > 0.0]].all()
+        assert drawn[position[:10]].all()
+        left_out += (~drawn).sum()
+    assert left_out > 0.35 * 32 * len(normals)
+
+
+def test_view_fit_cell_corners_match_the_row_wise_unique():
+    """cell_corners packs each cell into one int64 for a fast unique: the same corners as by rows."""
+    from hao_addon.core.bake.views import cell_corners
+    points = np.random.default_rng(2).normal(size=(20_000, 3)) * 0.4
+    cells = np.unique(np.floor(points / 0.01).astype(np.int64), axis=0)
+    offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    np.testing.assert_array_equal(cell_corners(points, 0.01), ((cells[:, None, :] + offsets[None]) * 0.01).reshape(-1, 3))

@@ -27,12 +27,13 @@ import gpu
 import numpy as np
 
 from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
-from ..core.bake.normal_bins import BIN_COUNT, bin_cones, bins_facing, normal_bins, octahedral_coords, proximity_order
+from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
+                                     normal_bins, octahedral_coords, proximity_order)
 from ..core.errors import BakeInputError
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
 from . import util
-from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch
+from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .shaders import cached_shader, glsl_source
 
 # Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
@@ -64,8 +65,9 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
     info.vertex_in(2, 'VEC4', "face")
     info.vertex_in(3, 'FLOAT', "bin")
     info.vertex_in(4, 'VEC3', "geometric")
-    if shading:
+    if shading:  # entries binned by their own shading normal
         info.define("SHADING_NORMALS", "1")
+        info.define("OCT_SIDE", str(OCT_SIDE))
     if terminator:  # each fragment's Cycles terminator lift (gpu_shaders/bake_terminator.glsl)
         assert shading
         info.define("TERMINATOR_OFFSET", "1")
@@ -128,8 +130,9 @@ SLOPE_BIAS_PIXELS = 0.25
 # A terminator lift (normalized units) shorter than this leaves a ray start on its facet (the
 # reference tracer's self-intersection offset is of the same size).
 MIN_LIFT = 1e-6
-# Dispatch only the entries of normal bins that can face a view (False: every entry; the
-# results are the same, tests/test_bake_analytic.py).
+# Dispatch only the entries of normal bins that can face a view, and draw into a depth map
+# culling one side of the faces only the bins that side can be in (False: every entry and
+# face; the results are the same, tests/test_bake_analytic.py).
 NORMAL_BINNING = True
 # Texel centres of the target's own UVs are listed by a UV-space raster on the GPU (the fast
 # path); sub-texel samples and Selected-to-Active receivers are made on the CPU
@@ -236,6 +239,9 @@ class GatherBaker(LightViewBaker):
         else:
             # One depth map per direction of a dispatch; they share the (never written) colour target.
             self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
+            # Depth maps culling one side of the faces draw only the bins that side can be in.
+            self.face_bins = FaceBins.of(plan.drawn_normals)
+            self.facing_batch = positions_batch(plan.drawn_positions[self.face_bins.order])
             self.depths = [gpu.types.GPUTexture((side, side), format='DEPTH_COMPONENT32F')
                            for _ in range(self.slots)]
             self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
@@ -251,7 +257,7 @@ class GatherBaker(LightViewBaker):
         self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
         self._build_texel_list()
         self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0,
-                          texel_list_entries=self.entry_count,
+                          texel_list_entries=self.entry_count, depth_faces_drawn=0, depth_faces_skipped=0,
                           averted_faces_drawn=0, averted_faces_skipped=0,
                           views_per_dispatch=self.slots, texel_tests=0, texel_tests_skipped=0,
                           layered=self.layered, layer_overflow_pixels=0,
@@ -276,11 +282,12 @@ class GatherBaker(LightViewBaker):
             return None
         faces = self.plan.target_faces
         bins = normal_bins(faces[:, :3])
-        # An entry weighs in wherever its shading normal faces the light: each bin's cone
-        # holds its corners' shading normals (and so every normal interpolated between them).
-        corners = self.plan.target_corners
-        self.bin_axis, self.bin_threshold = bin_cones(corners[..., :3].reshape(-1, 3), np.repeat(bins, 3),
-                                                      np.repeat(faces[:, 3] > 0.0, 3))
+        if self.plan.smooth_shading:
+            # An entry weighs in wherever its shading normal faces the light: the texel list
+            # bins each entry by that normal, so its bin's cone is the octahedral cell's.
+            self.bin_axis, self.bin_threshold = cell_cones()
+        else:
+            self.bin_axis, self.bin_threshold = bin_cones(faces[:, :3], bins, faces[:, 3] > 0.0)
         return plan_batch(self.plan, with_occluders=False, face_bins=bins, lift_corners=self.plan.lifts_terminator)
 
     def _views_fitted(self, indices: list[int], views: list) -> None:
@@ -324,10 +331,10 @@ class GatherBaker(LightViewBaker):
         self.accum.clear(format='FLOAT', value=(0.0, 0.0))
 
     def _upload_texel_list(self, receivers: Receivers) -> None:
-        """The list from CPU receivers: sorted by normal bin (of the true surface), both
-        normals octahedral-encoded (the SHADING_NORMALS layout)."""
+        """The list from CPU receivers: sorted by the normal bin of their shading normal (the
+        one their weight is about), both normals octahedral-encoded (the SHADING_NORMALS layout)."""
         receivers = receivers.subset(receivers.inv_s > 0.0)
-        bins = normal_bins(receivers.geometric)
+        bins = normal_bins(receivers.shading)
         order = np.argsort(bins, kind="stable")
         bins = bins[order]
         self.bin_axis, self.bin_threshold = bin_cones(receivers.shading[order], bins, np.ones(len(bins), bool))
@@ -382,6 +389,12 @@ class GatherBaker(LightViewBaker):
         bin_start = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32F',
                                          data=gpu.types.Buffer('FLOAT', BIN_COUNT, starts))
         draw(fill)
+        # Both passes bin each fragment by the same arithmetic on the same inputs; a GPU whose
+        # two variants rounded a shading normal differently would have filled a neighbour's range.
+        filled = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
+        if not np.array_equal(filled, per_bin):
+            raise RuntimeError(f"the texel list's fill pass binned {int(np.abs(filled - per_bin).sum())} entries "
+                               f"differently from its count pass")
 
     def _entry_runs(self, omegas: np.ndarray) -> list[tuple[int, int]]:
         """(first entry, end entry) runs of the bins that can face one of omegas (k, 3)."""
@@ -389,18 +402,10 @@ class GatherBaker(LightViewBaker):
             needed = bins_facing(self.bin_axis, self.bin_threshold, omegas)
         else:
             needed = np.ones(BIN_COUNT, bool)
-        needed |= self.bin_first[1:] == self.bin_first[:-1]  # empty bins join their neighbours' runs
-        picked = np.flatnonzero(needed)
-        if len(picked) == 0:
-            return []
-        breaks = np.flatnonzero(np.diff(picked) > 1)
-        first = np.concatenate([picked[:1], picked[breaks + 1]])
-        last = np.concatenate([picked[breaks], picked[-1:]])
-        runs = [(int(self.bin_first[a]), int(self.bin_first[b + 1])) for a, b in zip(first, last)]
-        return [(a, b) for a, b in runs if b > a]
+        return bin_runs(needed, self.bin_first)
 
     def _release(self) -> None:
-        self.depths = self.depth_fbs = self.dummy = self.views_block = None
+        self.depths = self.depth_fbs = self.dummy = self.views_block = self.facing_batch = self.face_bins = None
         self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
         self.pending = []
         self.chunks = None
@@ -418,7 +423,14 @@ class GatherBaker(LightViewBaker):
                                else 'NONE', self.layer_count, self.layer_depth, self.overflow)
             else:
                 culling, runs = self._depth_map_faces(index)
-                depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs)
+                facing = None
+                if culling != 'NONE' and NORMAL_BINNING:  # faces turned towards ('BACK') or away from the light
+                    toward = view.omega if culling == 'BACK' else -view.omega
+                    facing = (self.facing_batch, self.face_bins.runs(toward))
+                    drawn = sum(end - first for first, end in facing[1])
+                    self.stats["depth_faces_drawn"] += drawn
+                    self.stats["depth_faces_skipped"] += len(self.face_bins.order) - drawn
+                depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing)
         self.pending.append(view)
         if len(self.pending) == self.slots or index == plan.settings.directions - 1:
             self._test_pending_views()

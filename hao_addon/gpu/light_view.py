@@ -86,6 +86,26 @@ def depth_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_depth",), _depth_info)
 
 
+def _depth_positions_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC3', "pos")
+    info.push_constant('MAT4', "view_proj")
+    info.fragment_out(0, 'FLOAT', "dummy_out")
+    info.vertex_source(glsl_source("bake_depth_positions.vert"))
+    info.fragment_source(glsl_source("bake_depth.frag"))
+    return info
+
+
+def depth_positions_shader() -> "gpu.types.GPUShader":
+    """Depth-only drawing of a positions_batch."""
+    return cached_shader(("bake_depth_positions",), _depth_positions_info)
+
+
+def positions_batch(positions: np.ndarray) -> "gpu.types.GPUBatch":
+    """Triangle-soup batch of positions (F, 3, 3) alone (attribute "pos")."""
+    return util.make_batch('TRIS', {"pos": ('F32', positions.reshape(-1, 3))})
+
+
 def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = None,
                face_bins: np.ndarray | None = None, lift_corners: bool = False) -> "gpu.types.GPUBatch":
     """Triangle-soup batch of the target, optionally followed by the occluders (1/S_f = 0)
@@ -135,11 +155,14 @@ def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = Fals
 
 
 def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
-                  averted_runs: list[tuple[int, int]] = ()) -> None:
+                  averted_runs: list[tuple[int, int]] = (), facing=None) -> None:
     """Clear the view's sub-rectangle and draw `batch` depth-only from the light.
 
     averted_runs: (first face, face count) runs of `batch` whose faces turned away from the
     light are drawn as well, after the whole batch with `culling` (see GatherBaker).
+    facing: (positions_batch, (first face, end face) runs) drawn with `culling` instead of the
+    whole of `batch`: the same faces in another order, of which only the runs can pass that
+    culling (core/bake/normal_bins.FaceBins).
     Colour writes are masked: llvmpipe then runs its depth-only path. (Never mask colour in
     passes with image atomics: llvmpipe then skips their fragment shaders, side effects and
     all.) Call inside util.scoped_state()."""
@@ -156,8 +179,14 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
         gpu.state.depth_mask_set(True)
         gpu.state.face_culling_set(culling)
         gpu.state.color_mask_set(False, False, False, False)
-        bind_light_view(shader, view, 0, prepass=True)
-        batch.draw(shader)
+        if facing is None:
+            bind_light_view(shader, view, 0, prepass=True)
+            batch.draw(shader)
+        else:
+            positions_shader = depth_positions_shader()
+            bind_light_view(positions_shader, view, 0, prepass=True)
+            _draw_runs(facing[0], positions_shader, facing[1])
+            bind_light_view(shader, view, 0, prepass=True)
         if averted_runs:
             gpu.state.face_culling_set('FRONT')  # front = counter-clockwise = facing the light
             if hasattr(batch, "draw_range"):
@@ -166,6 +195,15 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
             else:  # a Blender without GPUBatch.draw_range: every averted face, still exact
                 batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
+
+
+def _draw_runs(batch, shader, runs: list[tuple[int, int]]) -> None:
+    """Draw the (first face, end face) runs of batch (all of it on a Blender without draw_range)."""
+    if not hasattr(batch, "draw_range"):
+        batch.draw(shader)
+        return
+    for first, end in runs:
+        batch.draw_range(shader, elem_start=3 * first, elem_count=3 * (end - first))
 
 
 VIEW_PREFETCH = 16

@@ -18,6 +18,7 @@ be cancelled during a projection of seconds.
 from __future__ import annotations
 
 import time
+from itertools import repeat
 from dataclasses import dataclass
 from typing import Generator
 
@@ -126,10 +127,16 @@ def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.nda
     cast = []
     for start in range(0, len(usable), RAYS_PER_STEP):
         chunk = usable[start:start + RAYS_PER_STEP]
-        cast.extend(ray_cast(o, d, reach) for o, d in zip(origins[chunk].tolist(), directions[chunk].tolist()))
+        cast.extend(map(ray_cast, origins[chunk].tolist(), directions[chunk].tolist(), repeat(reach, len(chunk))))
         yield (start + len(chunk)) / len(usable)
-    index = np.array([-1 if c[2] is None else c[2] for c in cast], np.int64)
-    distance = np.array([0.0 if c[3] is None else c[3] for c in cast])
+    # A miss is (None, None, None, None): its index and distance become -1 and 0.
+    index = np.array([c[2] for c in cast], dtype=object)
+    missed = np.equal(index, None)
+    index[missed] = -1
+    index = index.astype(np.int64)
+    distance = np.array([c[3] for c in cast], dtype=object)
+    distance[missed] = 0.0
+    distance = distance.astype(np.float64)
     face = np.full(len(origins), -1, np.int64)
     face[usable] = index
     points = origins.copy()

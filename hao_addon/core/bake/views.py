@@ -107,6 +107,16 @@ def cell_corners(points: np.ndarray, cell: float) -> np.ndarray:
     whose projection along any direction covers the points' (light views are fitted to them)."""
     if len(points) == 0:
         return np.zeros((1, 3))
-    keys = np.unique(np.floor(points / cell).astype(np.int64), axis=0)
+    cells = np.floor(points / cell).astype(np.int64)
+    low = cells.min(axis=0)
+    span = cells.max(axis=0) - low + 1
+    if np.prod(span.astype(np.float64)) < 2.0**62:
+        # One int64 per cell: a 1-D unique (30 ms for 600k points; by rows 700 ms).
+        packed = np.unique(((cells[:, 0] - low[0]) * span[1] + (cells[:, 1] - low[1])) * span[2] + (cells[:, 2] - low[2]))
+        rest, z = np.divmod(packed, span[2])
+        x, y = np.divmod(rest, span[1])
+        keys = np.stack([x, y, z], axis=1) + low
+    else:
+        keys = np.unique(cells, axis=0)
     offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
     return ((keys[:, None, :] + offsets[None]) * cell).reshape(-1, 3)
