@@ -1,6 +1,7 @@
 /* Shadow-map gather (the comparison of McGraw & Sowers' Table 1): every texel-list entry is
- * tested against the depth maps of VIEWS directions (1 to 4, one dispatch) and adds (V w, w),
- * w = weight(omega . n) / S_f, for each. Loading an entry and its running sums once for
+ * tested against the depth maps of VIEWS directions (1 to 4, one dispatch) and adds the
+ * estimator's term of (w, V, omega) for each (bake_estimator.glsl; for AO (V w, w)),
+ * w = weight(omega . n) / S_f. Loading an entry and its running sums once for
  * several directions is what batching saves (llvmpipe: the loads and the store cost more
  * than the tests). Each invocation owns its entry, so the float sums need no atomics; they
  * are added one direction at a time in direction order, the same arithmetic as one
@@ -123,7 +124,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
       float cos_true = dot(geometric, views.omega[k].xyz); \
       TERMINATOR_VISIBLE(depth_tex, k, cos_theta, cos_true) \
-      sum += vec2(weight * visible, weight); \
+      sum += ESTIMATOR_TERM(weight, visible, views.omega[k].xyz); \
     } \
   }
 #else
@@ -132,7 +133,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
     float cos_theta = dot(normal, views.omega[k].xyz); \
     if (cos_theta > 0.0) { \
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
-      sum += vec2(weight * VISIBLE(depth_tex, k, normal), weight); \
+      sum += ESTIMATOR_TERM(weight, VISIBLE(depth_tex, k, normal), views.omega[k].xyz); \
     } \
   }
 #endif
@@ -158,8 +159,8 @@ void main()
 #else
   vec3 normal = imageLoad(entry_normal, slot).xyz;
 #endif
-  vec2 sum = imageLoad(accum, slot).xy;
-  vec2 before = sum;
+  EstimatorSums sum = ESTIMATOR_LOAD(accum, slot);
+  EstimatorSums before = sum;
   GATHER_VIEW(depth_tex0, 0)
 #if VIEWS > 1
   GATHER_VIEW(depth_tex1, 1)
@@ -171,6 +172,6 @@ void main()
   GATHER_VIEW(depth_tex3, 3)
 #endif
   if (sum != before) {
-    imageStore(accum, slot, vec4(sum, 0.0, 0.0));
+    ESTIMATOR_STORE(accum, slot, sum);
   }
 }

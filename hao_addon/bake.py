@@ -104,11 +104,12 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         for i in range(count):
             baker.run_direction(i)
             yield share + (1.0 - share) * (i + 1) / count
-        numerator, denominator = baker.accumulated()
+        sums = baker.accumulated()
         gpu_stats = dict(baker.stats)
     finally:
         baker.free()
-    ao, covered, filled = finalize_map(numerator, denominator, settings.margin)
+    # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py).
+    ao, covered, filled = finalize_map(*plan.estimator.ratio(sums), settings.margin)
     stats = {**plan.stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "seconds": time.perf_counter() - t0, "cache_hit": False}
     result = BakeResult(ao, covered, filled, stats)

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The one factory of bake passes: a method name -> its baker class. Every baker takes a
-BakePlan and offers check_limits(plan), run_direction(i), accumulated() -> (numerator,
-denominator), stats and free(); the tests run each on the same scenes."""
+BakePlan and offers check_limits(plan), run_direction(i), accumulated() -> (size, size,
+channels) the sums of the plan's estimator (core/bake/estimators.py), stats and free(); the
+tests run each on the same scenes."""
 from __future__ import annotations
 
 BAKE_METHODS = ("scatter", "gather", "reference")

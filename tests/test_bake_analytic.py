@@ -207,3 +207,45 @@ def test_wendland_falloff_is_the_papers_kernel(gpu_context, method):
     extra = ((1.0 - s) ** 4 * s * 2.0 * np.sqrt(1.0 - y * y)).sum(axis=1) / 4096 / np.pi  # w4 - w3
     mutant = (ref.ravel() + extra).reshape(size, size)
     assert error_stats(mutant, ref, mask & res.covered)["bias"] > 4 * sigma(directions) / 8
+
+
+@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
+def test_every_baker_returns_the_estimators_sums(gpu_context, method):
+    """The bakers find visibility their own way and return the plan's estimator sums per texel
+    (core/bake/estimators.py): (size, size, channels), the weight sum last; for ambient
+    occlusion the map is their ratio and the numerator never exceeds the weight sum."""
+    from hao_addon.bakers import baker_for
+    from hao_addon.core.bake.estimators import AMBIENT_OCCLUSION
+    from hao_addon.core.bake.plan import make_plan
+    from hao_addon.core.bake.seams import finalize_map
+    plane, sphere = sphere_on_plane()
+    settings = BakeSettings(size=32, directions=16, method=method, margin=0)
+    plan = make_plan(plane, [sphere], settings)
+    assert plan.estimator is AMBIENT_OCCLUSION
+    baker = baker_for(method)(plan)
+    try:
+        for i in range(settings.directions):
+            baker.run_direction(i)
+        sums = baker.accumulated()
+    finally:
+        baker.free()
+    assert sums.shape == (32, 32, AMBIENT_OCCLUSION.channel_count)
+    np.testing.assert_array_equal(finalize_map(*AMBIENT_OCCLUSION.ratio(sums), 0)[0],
+                                  bake(plane, [sphere], settings, use_cache=False).ao)
+    weight, visible = np.array([0.5, 0.25]), np.array([1.0, 0.0])
+    np.testing.assert_array_equal(AMBIENT_OCCLUSION.terms(weight, visible, np.array([0.0, 0.0, 1.0])),
+                                  [[0.5, 0.5], [0.0, 0.25]])
+    assert (sums[..., 0] <= sums[..., 1] * (1.0 + 1e-6) + 1e-12).all()  # V <= 1
+
+
+def test_the_scatter_refuses_an_estimator_it_cannot_pack(gpu_context, monkeypatch):
+    """The scatter's accumulator packs (numerator <= weight) into one word: another estimator
+    gets one clear message, not a wrong map."""
+    from hao_addon.core.bake import plan as plan_module
+    from hao_addon.core.bake.estimators import Estimator
+    from hao_addon.core.errors import BakeInputError
+    other = Estimator("bent normals", ("bent_x", "bent_y", "bent_z", "weight"), "ESTIMATOR_TEST_ONLY")
+    monkeypatch.setattr(plan_module.BakePlan, "estimator", property(lambda self: other))
+    plane, sphere = sphere_on_plane()
+    with pytest.raises(BakeInputError, match="ambient occlusion only"):
+        bake(plane, [sphere], BakeSettings(size=32, directions=4, method="scatter"), use_cache=False)

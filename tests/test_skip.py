@@ -86,7 +86,7 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
             try:
                 for i in range(p.settings.directions):
                     baker.run_direction(i)
-                maps.append(finalize_map(*baker.accumulated(), 0))
+                maps.append(finalize_map(*baker.plan.estimator.ratio(baker.accumulated()), 0))
             finally:
                 baker.free()
         (culled, covered, _), (full, covered_full, _) = maps
@@ -127,7 +127,7 @@ def test_gather_draws_averted_faces_only_where_the_light_looks_into_a_hole(gpu_c
         try:
             for i in range(settings.directions):
                 baker.run_direction(i)
-            maps.append(finalize_map(*baker.accumulated(), 0))
+            maps.append(finalize_map(*baker.plan.estimator.ratio(baker.accumulated()), 0))
             stats.append(dict(baker.stats))
         finally:
             baker.free()

@@ -30,6 +30,7 @@ from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
                                      normal_bins, octahedral_coords, proximity_order)
 from ..core.errors import BakeInputError
+from ..core.bake.estimators import AMBIENT_OCCLUSION, Estimator
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
 from . import util
@@ -40,12 +41,12 @@ from .shaders import cached_shader, glsl_source
 # within the 16384-texel texture limit; the compute grid is LIST_WIDTH / 64 groups wide.
 LIST_WIDTH = 4096
 GROUP_SIZE = 64
-ENTRY_BYTES = 16 + 16 + 4 + 8  # position + 1/S_f, normal, texel, (numerator, denominator)
+ENTRY_BYTES = 16 + 16 + 4  # position + 1/S_f, normal, texel (and 4 bytes per estimator channel)
 LIFT_BYTES = 16  # an entry's terminator lift, where the plan lifts (plan.lifts_terminator)
 
 
 def entry_bytes(plan: BakePlan) -> int:
-    return ENTRY_BYTES + (LIFT_BYTES if plan.lifts_terminator else 0)
+    return ENTRY_BYTES + 4 * plan.estimator.channel_count + (LIFT_BYTES if plan.lifts_terminator else 0)
 
 
 # The texel-list attributes of the terminator lift (plan_batch's lift_corners): the face's
@@ -156,12 +157,18 @@ def views_per_dispatch(plan: BakePlan) -> int:
     return VIEWS_PER_DISPATCH
 
 
-def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool
-                 ) -> "gpu.types.GPUShaderCreateInfo":
+# The accumulator image of an estimator's sums, by channel count (gpu_shaders/bake_estimator.glsl).
+ACCUM_FORMATS = {2: 'RG32F', 4: 'RGBA32F'}
+
+
+def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool,
+                 estimator: Estimator) -> "gpu.types.GPUShaderCreateInfo":
     """falloff: None for unlimited distance (depth maps), else the max-distance falloff
     ('none', 'wendland'), tested against per-pixel depth lists; terminator: entries carry
-    their terminator lift (image entry_lift)."""
+    their terminator lift (image entry_lift); estimator: what each direction adds."""
     info = gpu.types.GPUShaderCreateInfo()
+    info.define(estimator.define, "1")
+    info.define("ESTIMATOR_CHANNELS", str(estimator.channel_count))
     if shading:
         info.define("SHADING_NORMALS", "1")
     if terminator:
@@ -184,7 +191,7 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
     info.uniform_buf(0, "GatherViews", "views")
     info.image(0, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'READ'})
-    info.image(2, 'RG32F', 'FLOAT_2D', "accum", qualifiers={'READ', 'WRITE'})
+    info.image(2, ACCUM_FORMATS[estimator.channel_count], 'FLOAT_2D', "accum", qualifiers={'READ', 'WRITE'})
     if falloff is None:
         for k in range(views):
             info.sampler(k, 'FLOAT_2D', f"depth_tex{k}")
@@ -198,16 +205,17 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         info.image(4, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ'})
         info.push_constant('FLOAT', "max_distance")
     info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_terminator.glsl",
-                                    "bake_gather.comp"))
+                                    "bake_estimator.glsl", "bake_gather.comp"))
     return info
 
 
 def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
-                  terminator: bool = False) -> "gpu.types.GPUShader":
+                  terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to VIEWS_PER_DISPATCH) directions per dispatch; shading:
-    entries carry shading normals (plan.smooth_shading); falloff, terminator: see _gather_info."""
-    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator),
-                         lambda: _gather_info(uniform, views, shading, falloff, terminator))
+    entries carry shading normals (plan.smooth_shading); falloff, terminator, estimator: see
+    _gather_info."""
+    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator, estimator.define),
+                         lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator))
 
 
 class GatherBaker(LightViewBaker):
@@ -327,8 +335,9 @@ class GatherBaker(LightViewBaker):
             self.entry_position, self.entry_normal = (texture(v) for v in uploaded[:2])
             if len(uploaded) > 2:
                 self.entry_lift = texture(uploaded[2])
-        self.accum = gpu.types.GPUTexture(shape, format='RG32F')
-        self.accum.clear(format='FLOAT', value=(0.0, 0.0))
+        channels = self.plan.estimator.channel_count
+        self.accum = gpu.types.GPUTexture(shape, format=ACCUM_FORMATS[channels])
+        self.accum.clear(format='FLOAT', value=(0.0,) * channels)
 
     def _upload_texel_list(self, receivers: Receivers) -> None:
         """The list from CPU receivers: sorted by the normal bin of their shading normal (the
@@ -470,7 +479,7 @@ class GatherBaker(LightViewBaker):
         self.views_block.update(self.views_data.view(np.float32))
         settings = self.plan.settings
         shader = gather_shader(settings.weighting == "uniform", len(views), self.shading_layout,
-                               settings.falloff if self.layered else None, self.lifted)
+                               settings.falloff if self.layered else None, self.lifted, self.plan.estimator)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         if self.layered:
@@ -500,21 +509,21 @@ class GatherBaker(LightViewBaker):
         self.stats["texel_tests"] += tested * len(views)
         self.stats["texel_tests_skipped"] += (self.entry_count - tested) * len(views)
 
-    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
-        """(numerator, denominator), each (size, size) float64: the entries summed per texel."""
+    def accumulated(self) -> np.ndarray:
+        """(size, size, channels) float64: the estimator's sums, the entries summed per texel."""
         self._test_pending_views()  # directions of a bake stopped short of its last one
         if self.layered:  # pixels whose depth list overflowed, counted over the whole bake
             self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
         size = self.plan.settings.size
         n = self.entry_count
+        channels = self.plan.estimator.channel_count
         if n == 0:
-            return np.zeros((size, size)), np.zeros((size, size))
-        sums = util.texture_to_numpy(self.accum, np.float32).reshape(-1, 2)[:n].astype(np.float64)
+            return np.zeros((size, size, channels))
+        sums = util.texture_to_numpy(self.accum, np.float32).reshape(-1, channels)[:n].astype(np.float64)
         if self.receivers is not None:
             flat = self.entry_texels
         else:
             texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
             flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
-        num = np.bincount(flat, weights=sums[:, 0], minlength=size * size)
-        den = np.bincount(flat, weights=sums[:, 1], minlength=size * size)
-        return num.reshape(size, size), den.reshape(size, size)
+        return np.stack([np.bincount(flat, weights=sums[:, c], minlength=size * size) for c in range(channels)],
+                        axis=-1).reshape(size, size, channels)

@@ -25,6 +25,7 @@ import gpu
 import numpy as np
 
 from ..core.errors import BakeInputError
+from ..core.bake.estimators import AMBIENT_OCCLUSION
 from ..core.bake.plan import BakePlan
 from . import util
 from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
@@ -86,6 +87,11 @@ class ScatterBaker(LightViewBaker):
         if plan.projected is not None:
             raise BakeInputError("the histogram scatter cannot bake Selected to Active (it draws the target's own "
                                  "surface); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
+        # Its accumulator packs (numerator, denominator) with numerator <= denominator in one
+        # word (gpu_shaders/bake_common.glsl): the ambient-occlusion estimator's sums only.
+        if plan.estimator is not AMBIENT_OCCLUSION:
+            raise BakeInputError(f"the histogram scatter bakes ambient occlusion only, not {plan.estimator.name}; "
+                                 f"use the gather (Shadow-Map Gather) or the reference")
         super().check_limits(plan)
 
     @staticmethod
@@ -195,9 +201,10 @@ class ScatterBaker(LightViewBaker):
             self.num += (packed & 0xFFFF).astype(np.float64) / self.fixed_scale
             self.pending = 0
 
-    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
-        """(numerator, denominator), each (size, size) float64, over the directions so far."""
+    def accumulated(self) -> np.ndarray:
+        """(size, size, 2) float64: the ambient-occlusion estimator's sums (numerator, weight)
+        over the directions so far."""
         self.flush()
         if self.layered:  # pixels whose depth list overflowed, counted over the whole bake
             self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
-        return self.num, self.den
+        return np.stack([self.num, self.den], axis=-1)

@@ -16,6 +16,7 @@ from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
+from .estimators import AMBIENT_OCCLUSION, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, check_high_to_low, drain, projected_receivers_steps
 from .receivers import Receivers, uv_receivers
@@ -84,6 +85,12 @@ class BakePlan:
             return self.projected
         return uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
                             self.settings.size, self.settings.sample_count, self.lifts_terminator)
+
+    @property
+    def estimator(self) -> Estimator:
+        """What each direction adds to a receiver's sums (core/bake/estimators.py): ambient
+        occlusion, the one output the bake has today."""
+        return AMBIENT_OCCLUSION
 
     @property
     def lifts_terminator(self) -> bool:

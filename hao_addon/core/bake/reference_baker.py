@@ -8,7 +8,7 @@ every bake test runs it on the scenes the GPU passes bake. Receivers are the tex
 of the target's UV layout (as the gather's), their sub-texel samples, or the high-poly
 points of a Selected-to-Active bake (core/bake/receivers.py); per direction each adds (V w, w) with
 w = weight(omega . n_s) / S interpolated like the GPU passes interpolate them, and V the
-visibility: one ray towards the light with the plan's max distance, falloff and back-face
+visibility (the estimator, core/bake/estimators.py, turns (w, V, omega) into its sums): one ray towards the light with the plan's max distance, falloff and back-face
 rule, from the receiver or, where Cycles' terminator offset lifts it (core/bake/terminator.py),
 from the lifted point; 0 for a direction below the true surface that is not lifted (such a ray
 would enter the surface, as it does in Cycles' AO pass). Slow (a Python
@@ -66,8 +66,8 @@ class ReferenceBaker:
         self.offsets = np.array([ray_offset(p, radius) for p in self.points])
         self.origins = [Vector(p) for p in self.points + self.geometric * self.offsets[:, None]]
         self.lift = receivers.lift
-        self.num = np.zeros(len(self.points))
-        self.den = np.zeros(len(self.points))
+        self.estimator = plan.estimator
+        self.sums = np.zeros((len(self.points), self.estimator.channel_count))
         self.stats = dict(receivers=len(self.points), rays_traced=0, rays_lifted=0, rays_below_surface=0,
                           directions_done=0, shading_normals=plan.smooth_shading)
 
@@ -96,20 +96,19 @@ class ReferenceBaker:
             dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals)
         visible = 1.0 - occlusion_weight(dists, self.plan.max_distance_normalized if settings.max_distance > 0.0
                                          else 0.0, settings.falloff)
-        self.num += weight * visible
-        self.den += weight
+        self.sums += self.estimator.terms(weight, visible, omega)
         traced = (above & (weight > 0.0)) | lifted
         self.stats["rays_traced"] += int(traced.sum())
         self.stats["rays_lifted"] += int(lifted.sum())
         self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above & ~lifted).sum())
         self.stats["directions_done"] += 1
 
-    def accumulated(self) -> tuple[np.ndarray, np.ndarray]:
-        """(numerator, denominator), each (size, size) float64."""
+    def accumulated(self) -> np.ndarray:
+        """(size, size, channels) float64: the estimator's sums per texel."""
         size = self.plan.settings.size
-        num = np.bincount(self.texel, weights=self.num, minlength=size * size)
-        den = np.bincount(self.texel, weights=self.den, minlength=size * size)
-        return num.reshape(size, size), den.reshape(size, size)
+        channels = self.estimator.channel_count
+        return np.stack([np.bincount(self.texel, weights=self.sums[:, c], minlength=size * size)
+                         for c in range(channels)], axis=-1).reshape(size, size, channels)
 
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""

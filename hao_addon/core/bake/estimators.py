@@ -1,0 +1,62 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The estimator of a bake (receivers x estimator x output): what each light direction adds to
+a receiver's sums, and what the map is made of them (pure numpy).
+
+Every baker evaluates, per receiver and direction omega, the hemisphere weight w (about the
+shading normal, times the receiver's exact 1 / S) and the visibility V in [0, 1] (its own
+business: depth maps, splats or rays), and hands (w, V, omega) to the estimator, which turns
+them into `channels` floats to sum. The last channel is always the weight sum W = sum(w), the
+coverage every output is normalized and dilated by (core/bake/seams.py).
+
+The GPU passes get the same term as GLSL (gpu_shaders/bake_estimator.glsl, selected by the
+estimator's define; the channel count arrives as ESTIMATOR_CHANNELS), the reference baker
+calls terms() (core/bake/reference_baker.py): one definition per estimator, and the twins
+differ only in how they find V. A new output of the same bake (bent normals: sum(w V omega)
+besides sum(w V)) is a new Estimator with its channels, GLSL term and finish().
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Estimator:
+    """name: what the map is; channels: the per-receiver sums, in order, the weight sum W
+    last; define: the GLSL define selecting its term."""
+
+    name: str
+    channels: tuple[str, ...]
+    define: str
+
+    @property
+    def channel_count(self) -> int:
+        return len(self.channels)
+
+    def terms(self, weight: np.ndarray, visible: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        """(n, channel_count) float64: what direction omega (3,) adds to n receivers of weight
+        (n,) and visibility (n,)."""
+        raise NotImplementedError
+
+    def ratio(self, sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(numerator, W) of the scalar map, each (...) float64, from sums (..., channel_count):
+        the map is numerator / W where W > 0 (core/bake/seams.finalize_map)."""
+        raise NotImplementedError
+
+
+class AmbientOcclusion(Estimator):
+    """Accessibility: sum(w V) / sum(w), 1 where nothing occludes (the paper's equation 8 for
+    the scatter, a point sample of the same integral for the gather and the reference)."""
+
+    def __init__(self) -> None:
+        super().__init__("ambient occlusion", ("visible_weight", "weight"), "ESTIMATOR_AMBIENT_OCCLUSION")
+
+    def terms(self, weight: np.ndarray, visible: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        return np.stack([weight * visible, weight], axis=-1)
+
+    def ratio(self, sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return sums[..., 0], sums[..., 1]
+
+
+AMBIENT_OCCLUSION = AmbientOcclusion()
