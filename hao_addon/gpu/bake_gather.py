@@ -30,7 +30,7 @@ from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
                                      normal_bins, octahedral_coords, proximity_order)
 from ..core.errors import BakeInputError
-from ..core.bake.estimators import AMBIENT_OCCLUSION, Estimator
+from ..core.bake.estimators import AMBIENT_OCCLUSION, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
 from . import util
@@ -525,5 +525,4 @@ class GatherBaker(LightViewBaker):
         else:
             texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
             flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
-        return np.stack([np.bincount(flat, weights=sums[:, c], minlength=size * size) for c in range(channels)],
-                        axis=-1).reshape(size, size, channels)
+        return texel_sums(flat, sums, size)

@@ -186,7 +186,8 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
             positions_shader = depth_positions_shader()
             bind_light_view(positions_shader, view, 0, prepass=True)
             _draw_runs(facing[0], positions_shader, facing[1])
-            bind_light_view(shader, view, 0, prepass=True)
+            if averted_runs:
+                bind_light_view(shader, view, 0, prepass=True)
         if averted_runs:
             gpu.state.face_culling_set('FRONT')  # front = counter-clockwise = facing the light
             if hasattr(batch, "draw_range"):

@@ -60,3 +60,9 @@ class AmbientOcclusion(Estimator):
 
 
 AMBIENT_OCCLUSION = AmbientOcclusion()
+
+
+def texel_sums(texel: np.ndarray, sums: np.ndarray, size: int) -> np.ndarray:
+    """(size, size, C) float64: receivers' sums (n, C) added up per flat texel index (n,)."""
+    return np.stack([np.bincount(texel, weights=sums[:, c], minlength=size * size) for c in range(sums.shape[1])],
+                    axis=-1).reshape(size, size, sums.shape[1])

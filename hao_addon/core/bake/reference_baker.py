@@ -21,6 +21,7 @@ from mathutils import Vector
 
 from ..errors import BakeInputError
 from ..kernels import occlusion_weight
+from .estimators import texel_sums
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from .terminator import lift_amount
@@ -105,10 +106,7 @@ class ReferenceBaker:
 
     def accumulated(self) -> np.ndarray:
         """(size, size, channels) float64: the estimator's sums per texel."""
-        size = self.plan.settings.size
-        channels = self.estimator.channel_count
-        return np.stack([np.bincount(self.texel, weights=self.sums[:, c], minlength=size * size)
-                         for c in range(channels)], axis=-1).reshape(size, size, channels)
+        return texel_sums(self.texel, self.sums, self.plan.settings.size)
 
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""
