@@ -1,7 +1,8 @@
 /* Shadow-map gather (the comparison of McGraw & Sowers' Table 1): every texel-list entry is
  * tested against the depth maps of VIEWS directions (1 to 4, one dispatch) and adds the
  * estimator's term of (w, V, omega) for each (bake_estimator.glsl; for AO (V w, w)),
- * w = weight(omega . n) / S_f. Loading an entry and its running sums once for
+ * w = weight(omega . n) times the entry's scale (1 / S where the plan knows it; each entry's
+ * sums are divided by its own weight sum on read-back, estimators.texel_sums). Loading an entry and its running sums once for
  * several directions is what batching saves (llvmpipe: the loads and the store cost more
  * than the tests). Each invocation owns its entry, so the float sums need no atomics; they
  * are added one direction at a time in direction order, the same arithmetic as one
@@ -84,7 +85,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
 #endif
 #define VISIBLE(depth_tex, k, plane_normal) VISIBLE_AT(depth_tex, k, position.xyz, plane_normal, SLOPE_BIAS_PIXELS)
 
-/* Hemisphere weight of a light at cos_theta > 0 (times 1 / S, added in GATHER_VIEW). */
+/* Hemisphere weight of a light at cos_theta > 0 (times the entry's scale, added in GATHER_VIEW). */
 #ifdef UNIFORM_WEIGHTING
 #  define VIEW_WEIGHT(cos_theta) 1.0
 #else
@@ -147,7 +148,7 @@ void main()
     return;
   }
   ivec2 slot = ivec2(index % LIST_WIDTH, index / LIST_WIDTH);
-  vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = 1 / S */
+  vec4 position = imageLoad(entry_position, slot); /* xyz normalized world, w = the weight scale */
 #ifdef SHADING_NORMALS
   vec4 normals = imageLoad(entry_normal, slot);
   vec3 normal = octahedral_decode(normals.xy);

@@ -414,3 +414,19 @@ def test_view_fit_cell_corners_match_the_row_wise_unique():
     cells = np.unique(np.floor(points / 0.01).astype(np.int64), axis=0)
     offsets = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
     np.testing.assert_array_equal(cell_corners(points, 0.01), ((cells[:, None, :] + offsets[None]) * 0.01).reshape(-1, 3))
+
+
+def test_texel_sums_normalize_each_receiver_by_its_own_weight_sum():
+    """Every lit receiver weighs 1 in its texel whatever its weight scale (the gather's and
+    the reference's exact normalization): texel 0 holds receivers of ratio 0.2 and 0.8 with
+    weight sums 10 and 1000, texel 1 one of ratio 0.5 and one no direction lit."""
+    from hao_addon.core.bake.estimators import AMBIENT_OCCLUSION, texel_sums
+
+    texel = np.array([0, 0, 1, 1])
+    sums = np.array([[2.0, 10.0], [800.0, 1000.0], [3.0, 6.0], [0.0, 0.0]])
+    out = texel_sums(texel, sums, 2)
+    numerator, weight = AMBIENT_OCCLUSION.ratio(out)
+    np.testing.assert_allclose(numerator.ravel(), [1.0, 0.5, 0.0, 0.0])
+    np.testing.assert_allclose(weight.ravel(), [2.0, 1.0, 0.0, 0.0])
+    scaled = texel_sums(texel, sums * np.array([7.0, 0.01, 3.0, 5.0])[:, None], 2)
+    np.testing.assert_allclose(scaled, out)

@@ -63,6 +63,15 @@ AMBIENT_OCCLUSION = AmbientOcclusion()
 
 
 def texel_sums(texel: np.ndarray, sums: np.ndarray, size: int) -> np.ndarray:
-    """(size, size, C) float64: receivers' sums (n, C) added up per flat texel index (n,)."""
-    return np.stack([np.bincount(texel, weights=sums[:, c], minlength=size * size) for c in range(sums.shape[1])],
-                    axis=-1).reshape(size, size, sums.shape[1])
+    """(size, size, C) float64: receivers' sums (n, C) added up per flat texel index (n,),
+    each receiver's first divided by its own weight sum W (the last channel).
+
+    That division is the exact normalization per receiver: every receiver that some direction
+    lights weighs 1 in its texel, whatever the discrete hemisphere weight sum S of its shading
+    normal, so any positive per-receiver scale of the weights (Receivers.inv_s, an interpolated
+    1 / S that keeps the GPU's float32 sums near 1) cancels. A receiver no direction lights
+    (W = 0) adds nothing."""
+    weight = sums[:, -1:]
+    normalized = np.divide(sums, weight, out=np.zeros_like(sums), where=weight > 0.0)
+    return np.stack([np.bincount(texel, weights=normalized[:, c], minlength=size * size)
+                     for c in range(sums.shape[1])], axis=-1).reshape(size, size, sums.shape[1])

@@ -214,7 +214,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     extent = 1.0  # radius of the receivers' sphere about the origin, normalized
     if high_to_low is not None:
         projected, projection_stats, warning = yield from projected_receivers_steps(
-            target, high_to_low, settings, directions, centre, scale)
+            target, high_to_low, settings, centre, scale)
         uv_warnings = uv_warnings + ([warning] if warning else [])
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))

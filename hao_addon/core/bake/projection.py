@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import time
 from itertools import repeat
+from operator import itemgetter
 from dataclasses import dataclass
 from typing import Generator
 
@@ -26,7 +27,7 @@ import numpy as np
 
 from ..errors import BakeInputError
 from ..geometry import TriangleSoup, corner_shading_normals, face_normals_areas, smooth_vertex_normals
-from .receivers import Receivers, exact_inverse_normalizers, interpolate_unit, texel_sample_points
+from .receivers import Receivers, interpolate_unit, texel_sample_points
 from .settings import BakeSettings
 from .terminator import smooth_surface_lift
 
@@ -121,26 +122,21 @@ def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.nda
     reach = max_ray_distance if max_ray_distance > 0.0 else 1e30
     ray_cast = bvh.ray_cast
     usable = np.flatnonzero(np.abs(directions).sum(axis=1) > 0.0)
-    # Only the casts run per ray in Python; each hit's face index and distance are gathered
-    # into arrays afterwards and the point is origin + distance * direction (storing each hit
-    # Vector into a numpy row cost about as much as the cast itself).
-    cast = []
+    # Only the casts run per ray in Python; each step's face indices and distances are read
+    # into arrays at once (a miss is (None, None, None, None): NaN as a float), and the point
+    # is origin + distance * direction (storing each hit Vector into a numpy row cost about as
+    # much as the cast itself).
+    face = np.full(len(origins), -1, np.int64)
+    distance = np.zeros(len(origins))
     for start in range(0, len(usable), RAYS_PER_STEP):
         chunk = usable[start:start + RAYS_PER_STEP]
-        cast.extend(map(ray_cast, origins[chunk].tolist(), directions[chunk].tolist(), repeat(reach, len(chunk))))
+        hits = list(map(ray_cast, origins[chunk].tolist(), directions[chunk].tolist(), repeat(reach, len(chunk))))
+        index = np.fromiter(map(itemgetter(2), hits), np.float64, len(hits))
+        found = ~np.isnan(index)
+        face[chunk[found]] = index[found]
+        distance[chunk[found]] = np.fromiter(map(itemgetter(3), hits), np.float64, len(hits))[found]
         yield (start + len(chunk)) / len(usable)
-    # A miss is (None, None, None, None): its index and distance become -1 and 0.
-    index = np.array([c[2] for c in cast], dtype=object)
-    missed = np.equal(index, None)
-    index[missed] = -1
-    index = index.astype(np.int64)
-    distance = np.array([c[3] for c in cast], dtype=object)
-    distance[missed] = 0.0
-    distance = distance.astype(np.float64)
-    face = np.full(len(origins), -1, np.int64)
-    face[usable] = index
-    points = origins.copy()
-    points[usable] += directions[usable] * distance[:, None]
+    points = origins + directions * distance[:, None]
     hit = face >= 0
     bary = np.zeros((len(origins), 3))
     bary[hit] = barycentric(points[hit], triangles[face[hit]])
@@ -165,19 +161,20 @@ def barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-30)
 
 
-def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, directions: np.ndarray,
-                        centre: np.ndarray, scale: float) -> tuple[Receivers, dict, str | None]:
+def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, centre: np.ndarray,
+                        scale: float) -> tuple[Receivers, dict, str | None]:
     """projected_receivers_steps() run to its end."""
-    return drain(projected_receivers_steps(target, request, settings, directions, centre, scale))
+    return drain(projected_receivers_steps(target, request, settings, centre, scale))
 
 
 def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,
-                              directions: np.ndarray, centre: np.ndarray, scale: float
+                              centre: np.ndarray, scale: float
                               ) -> Generator[float, None, tuple[Receivers, dict, str | None]]:
     """The receivers of a Selected-to-Active bake: the source points the target's texel
-    samples project to, with the sources' own shading normals (settings.normals), exact
-    1 / S, positions normalized by (centre (3,), scale). Returns them, stats, and a warning
-    when many texels found nothing."""
+    samples project to, with the sources' own shading normals (settings.normals), weight
+    scale 1 (each is normalized by its own weight sum: estimators.texel_sums), positions
+    normalized by (centre (3,), scale). Returns them, stats, and a warning when many texels
+    found nothing."""
     texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
     origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
     triangles = np.concatenate([s.positions for s in request.sources])
@@ -194,12 +191,11 @@ def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings
     shading = interpolate_unit(corners, hf, hb)
     geometric = face_normals[hf]
     points = (np.einsum("mk,mkd->md", hb, triangles[hf]) - centre) / scale
-    inv_s = exact_inverse_normalizers(shading, directions, settings.weighting)
     smooth = int((np.einsum("md,md->m", shading, geometric) < 1.0 - 1e-6).sum())
     lift = None
     if smooth and settings.terminator_offset > 0.0:  # Cycles lifts the high-poly's ray starts too
         lift = smooth_surface_lift(triangles[hf], corners[hf].astype(np.float64), hb, geometric) / scale
-    receivers = Receivers(points, geometric, shading, inv_s, texel[hit], lift)
+    receivers = Receivers(points, geometric, shading, np.ones(len(points)), texel[hit], lift)
     cells = settings.size * settings.size
     sampled = int((np.bincount(texel, minlength=cells) > 0).sum())
     missed = sampled - int((np.bincount(receivers.texel, minlength=cells) > 0).sum())

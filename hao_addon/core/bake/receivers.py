@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .normalization import hemisphere_weight
 from .terminator import smooth_surface_lift
 from .uv_raster import texel_surface_samples
 
@@ -24,8 +23,11 @@ from .uv_raster import texel_surface_samples
 class Receivers:
     """points: (n, 3) float64 normalized positions; geometric: (n, 3) unit normals of the true
     surface (rays start off it, directions below it are occluded); shading: (n, 3) unit
-    normals the hemisphere and the cosine weight are about; inv_s: (n,) 1 / S, S the exact
-    normalizer of the shading normal (0: never lit, the receiver adds nothing); texel: (n,)
+    normals the hemisphere and the cosine weight are about; inv_s: (n,) a positive scale of the
+    receiver's weights, 1 / S where the plan knows it (S the hemisphere weight sum of the
+    shading normal; it keeps the GPU's float32 sums near 1), else 1: it cancels, because
+    every receiver is normalized by its own weight sum (estimators.texel_sums); 0: never lit,
+    left out; texel: (n,)
     int64 flat texel index y * size + x; lift: (n, 3) normalized, Cycles' terminator lift of
     ray starts at full amount (core/bake/terminator.py), or None where nothing is lifted (flat
     shading, or the offset off)."""
@@ -72,19 +74,6 @@ def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) ->
     """(m, 3) unit vectors: corners (F, 3, 3) interpolated at (face (m,), bary (m, 3))."""
     v = np.einsum("mk,mkd->md", bary, corners[face].astype(np.float64))
     return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
-
-
-def exact_inverse_normalizers(shading: np.ndarray, directions: np.ndarray, weighting: str,
-                              chunk: int = 16384) -> np.ndarray:
-    """(n,) 1 / S for unit shading normals (n, 3): S = sum_d weight(omega_d . n), 0 where no
-    direction lights the normal."""
-    dirs_t = np.ascontiguousarray(np.asarray(directions, np.float32).T)
-    ones = np.ones(dirs_t.shape[1], np.float32)
-    s = np.empty(len(shading))
-    normals = np.asarray(shading, np.float32)
-    for start in range(0, len(shading), chunk):
-        s[start:start + chunk] = hemisphere_weight(normals[start:start + chunk] @ dirs_t, weighting) @ ones
-    return np.divide(1.0, s, out=np.zeros_like(s), where=s > 0.0)
 
 
 def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corners: np.ndarray, size: int,
