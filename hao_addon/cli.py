@@ -14,7 +14,7 @@ import os
 import sys
 import time
 import traceback
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 from . import __version__
@@ -230,8 +230,10 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     from .core.bake.settings import BakeSettings
 
     settings = _validated(settings_from_args(args, BakeSettings), BakeSettings)
-    report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     source = check_input(Path(args.input), INPUT_FORMATS)
+    if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
+        settings = replace(settings, terminator="setting")
+    report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     report.input = str(source)
     # Refused before a long load; checked again with the object's name once it is known.
     check_writable(args.out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 1, source=source)

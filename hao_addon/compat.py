@@ -35,3 +35,19 @@ def path_property_options() -> set[str]:
     if "is_path_supports_blend_relative" in bpy.types.Property.bl_rna.properties:
         return {'PATH_SUPPORTS_BLEND_RELATIVE'}
     return set()
+
+
+def object_terminator_offset(obj) -> float | None:
+    """The Shadow Terminator Geometry Offset Cycles bakes an object with, or None where this
+    Blender has no such property (Cycles not registered).
+
+    Newer releases (5.2 here) keep it on the object itself
+    (``Object.shadow_terminator_geometry_offset``, which their Cycles sync reads); 4.2 keeps it
+    in Cycles' object settings (``Object.cycles.shadow_terminator_geometry_offset``). 5.2 still
+    registers the Cycles one, which its Cycles no longer reads, so the object's own comes first."""
+    if "shadow_terminator_geometry_offset" in obj.bl_rna.properties:
+        return float(obj.shadow_terminator_geometry_offset)
+    cycles = getattr(obj, "cycles", None)
+    if cycles is not None and hasattr(cycles, "shadow_terminator_geometry_offset"):
+        return float(cycles.shadow_terminator_geometry_offset)
+    return None

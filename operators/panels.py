@@ -32,7 +32,10 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "normals")
         sub = col.column()
         sub.active = settings.normals == 'mesh'
-        sub.prop(settings, "terminator_offset")
+        sub.prop(settings, "terminator")
+        offset = sub.column()
+        offset.active = settings.normals == 'mesh' and settings.terminator == 'setting'
+        offset.prop(settings, "terminator_offset")
         col.prop(settings, "ignore_back_faces")
         col.prop(settings, "occluders")
         col.prop(settings, "samples_per_texel")

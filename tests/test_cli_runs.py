@@ -71,6 +71,8 @@ def test_object_token_and_json_report(dirs):
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
                                     smooth_corners=0)]  # spot.obj has no 's' groups: flat
     assert data["settings"]["size"] == 64 and data["settings"]["view_samples"] == 2.0
+    # An OBJ carries no terminator offset of its own: --terminator-offset (default 0.1) applies.
+    assert data["settings"]["terminator"] == "setting" and data["settings"]["terminator_offset"] == 0.1
     assert {"load", "bake", "write", "total", "unwrap"} <= set(data["timings"])
     assert any("outside the 0..1 UV tile" in w for w in data["warnings"])  # Spot's UVs reach past 0
     # '-' writes the report to stdout, and a failure is reported too (with nothing else written).

@@ -3,6 +3,8 @@
 its GLSL twin, and that the bakes match Cycles' own with it and do not without it."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -114,3 +116,51 @@ def test_gather_without_the_offset_misses_cycles_default_on_bent_normals(gpu_con
     t = cycles_truth(truth)[0][mask]
     assert res.stats["terminator_lift"] is False
     assert _rmse_bias(res.ao[mask], t)[1] < -0.02
+
+
+def _set_cycles_terminator(obj, value: float) -> None:
+    """Set the offset where the running Blender's Cycles reads it (compat.object_terminator_offset)."""
+    if "shadow_terminator_geometry_offset" in obj.bl_rna.properties:
+        obj.shadow_terminator_geometry_offset = value
+    else:
+        obj.cycles.shadow_terminator_geometry_offset = value
+
+
+def test_blender_bakes_use_each_objects_own_terminator_offset(scene):
+    """As Cycles: the baked object's Shadow Terminator Geometry Offset (Object > Shading), the
+    sources' largest in Selected to Active; Terminator 'setting' uses the panel's value.
+    The bake with the object's 0.0 is the bake with the setting 0.0, and differs from 0.1."""
+    import bpy
+    from conftest import small_settings, soup_to_object
+    from hao_addon import compat
+    from hao_addon.blender.bake_job import BakeJob, terminator_settings
+
+    obj = soup_to_object(_smooth_sphere(), "Ball")
+    for poly in obj.data.polygons:
+        poly.use_smooth = True
+    high = soup_to_object(_smooth_sphere(), "High")
+    settings = small_settings(scene, method='gather', directions=64)
+    _set_cycles_terminator(obj, 0.0)
+    _set_cycles_terminator(high, 0.35)
+    assert compat.object_terminator_offset(obj) == 0.0
+    base = settings.to_settings()
+    assert base.terminator == "object" and base.terminator_offset == pytest.approx(0.1)
+    assert terminator_settings(base, [obj]).terminator_offset == 0.0
+    assert terminator_settings(base, [obj, high]).terminator_offset == pytest.approx(0.35)
+    assert terminator_settings(replace(base, terminator="setting"), [obj]).terminator_offset == pytest.approx(0.1)
+
+    def bake_map(**kw):
+        for k, v in kw.items():
+            setattr(settings, k, v)
+        job = BakeJob(settings.to_request([obj]), bpy.context.evaluated_depsgraph_get)
+        job.run()
+        (_obj, _uv, result), = job.results
+        return result
+
+    own = bake_map(terminator='object')
+    assert own.stats["terminator_lift"] is False  # the object's 0.0: nothing lifted
+    fixed = bake_map(terminator='setting', terminator_offset=0.0)
+    np.testing.assert_array_equal(own.ao, fixed.ao)
+    lifted = bake_map(terminator_offset=0.1)
+    assert lifted.stats["terminator_lift"] is True and np.abs(lifted.ao - own.ao).max() > 0.01
+

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Generator
 
 import bpy
 
+from .. import compat
 from ..bake import BakeResult, bake_steps
 from ..core.imageio import check_writable, write_ao_file
 from ..core.bake.projection import HighToLow
@@ -51,6 +52,17 @@ class BakeRequest:
     source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None
+
+
+def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeSettings:
+    """settings with the terminator offset Cycles would use for these objects (the target, or
+    the high-poly sources whose points receive in Selected to Active): each object's own
+    where settings.terminator is 'object' and Blender has the property; several sources
+    with different offsets bake with the largest."""
+    if settings.terminator != "object":
+        return settings
+    offsets = [o for o in map(compat.object_terminator_offset, receiver_objects) if o is not None]
+    return replace(settings, terminator_offset=max(offsets)) if offsets else settings
 
 
 def output_path_for(request: BakeRequest, obj) -> str:
@@ -211,7 +223,8 @@ class BakeJob:
             skip = set(req.high_poly or ()) | {req.cage}
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
                          for o in self._occluder_objects(obj) if o not in skip]
-            gen = bake_steps(target, occluders, req.settings, high_to_low=high_to_low)
+            settings = terminator_settings(req.settings, req.high_poly or [obj])
+            gen = bake_steps(target, occluders, settings, high_to_low=high_to_low)
             try:
                 while True:
                     try:

@@ -36,6 +36,12 @@ METHOD_CHOICES = (
                                            "for checking a GPU bake"),
 )
 METHODS = tuple(c.value for c in METHOD_CHOICES)
+TERMINATOR_CHOICES = (
+    Choice("object", "Object's", "each object's own Shadow Terminator Geometry Offset (Object Properties > "
+                                 "Shading, Cycles), as Cycles' bake does; Terminator Offset where the input has "
+                                 "none (OBJ, glTF)"),
+    Choice("setting", "Terminator Offset", "the Terminator Offset setting for every object"),
+)
 SAMPLES_PER_TEXEL_CHOICES = (
     Choice("1", "Off", "one sample at each texel centre"),
     Choice("4", "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
@@ -83,11 +89,15 @@ class BakeSettings:
         0.0, label="Max Ray Distance", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
         description="Selected to Active: a high-poly surface farther than this from the ray start is not found; "
                     "0 = no limit")
+    terminator: str = setting(
+        "object", label="Terminator", noun="terminator offset source", choices=TERMINATOR_CHOICES,
+        description="where the terminator offset of a Blender object comes from")
     terminator_offset: float = setting(
         0.1, label="Terminator Offset", minimum=0.0, maximum=1.0,
         description="Cycles' Shadow Terminator Geometry Offset (its default 0.1): rays that graze a smooth-shaded "
                     "facet start from the smooth surface its normals describe, so the triangles do not show as "
-                    "dark bands; 0 = off. The scatter ignores it")
+                    "dark bands; 0 = off. Used for OBJ and glTF input and with Terminator 'setting'; "
+                    "the scatter ignores it")
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
