@@ -20,19 +20,23 @@ from .core.geometry import TriangleSoup
 from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
-from .core.bake.seams import finalize_map
+from .core.bake.estimators import BENT_NORMALS
+from .core.bake.seams import finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
 
 
 @dataclass
 class BakeResult:
     """ao: (size, size) float32 accessibility (1 = open), row 0 at v = 0 (Blender's pixel
-    order); covered: texels with a direct estimate; filled: covered plus margin."""
+    order); covered: texels with a direct estimate; filled: covered plus margin;
+    bent_normals: (size, size, 3) float32 unit world-space bent normals (zero outside
+    filled), or None unless settings.bent_normals."""
 
     ao: np.ndarray
     covered: np.ndarray
     filled: np.ndarray
     stats: dict = field(default_factory=dict)
+    bent_normals: np.ndarray | None = None
 
 
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
@@ -80,7 +84,8 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
         yield 1.0
-        return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True})
+        return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True},
+                          cached.bent_normals)
 
     share = PROJECTION_PROGRESS_SHARE if high_to_low is not None else 0.0
     planning = make_plan_steps(target, occluders, settings, high_to_low)
@@ -110,9 +115,12 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         baker.free()
     # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py).
     ao, covered, filled = finalize_map(*plan.estimator.ratio(sums), settings.margin)
+    bent = None
+    if plan.estimator is BENT_NORMALS:
+        bent = finalize_vectors(BENT_NORMALS.bent(sums), covered, filled, settings.margin)
     stats = {**plan.stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "seconds": time.perf_counter() - t0, "cache_hit": False}
-    result = BakeResult(ao, covered, filled, stats)
+    result = BakeResult(ao, covered, filled, stats, bent)
     if key is not None:
         _CACHE[key] = result
         while len(_CACHE) > _CACHE_SIZE:

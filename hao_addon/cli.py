@@ -21,6 +21,7 @@ from . import __version__
 from .cli_io import (EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, check_signals,
                      deferred_signals, pending_signal, signals_as_exceptions)
 from .cli_options import add_setting_options, option_for, settings_from_args
+from .core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 from .core.errors import BakeInputError
 from .core.setting_spec import SettingError
 
@@ -64,6 +65,12 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--cage", default="", metavar="NAME",
                    help="Selected to Active: a mesh in INPUT with the low-poly's topology that the rays start from "
                         "(instead of --cage-extrusion)")
+    b.add_argument("--bent-normal-out", default="", metavar="FILE",
+                   help="also bake bent normals (the cosine-weighted mean unoccluded direction, same pass) into "
+                        "this .png (16-bit) or .exr (32-bit float) RGB file, 0.5 + 0.5 n; {object} as in --out")
+    for option, choices in (("--bent-space", SPACE_CHOICES), ("--bent-convention", CONVENTION_CHOICES)):
+        b.add_argument(option, choices=[c.value for c in choices], default=choices[0].value,
+                       help="; ".join(f"{c.value}: {c.description}" for c in choices) + f" (default {choices[0].value})")
     _add_run_options(b)
 
     r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
@@ -233,6 +240,10 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     source = check_input(Path(args.input), INPUT_FORMATS)
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
+    if args.bent_normal_out:
+        settings = replace(settings, bent_normals=True)
+        check_writable(args.bent_normal_out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 4,
+                       source=source)
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     report.input = str(source)
     # Refused before a long load; checked again with the object's name once it is known.
@@ -254,7 +265,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                           filepath=str(Path(os.path.abspath(args.out))), source_path=str(source),
-                          high_poly=high_poly, cage=cage)
+                          high_poly=high_poly, cage=cage,
+                          bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
+                          bent_space=args.bent_space, bent_convention=args.bent_convention)
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     start_gpu()
     t0 = time.perf_counter()
@@ -279,6 +292,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                                    smooth_corners=st["smooth_corners"],
                                    **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {})))
         report.outputs.append(out)
+        bent_out = output_path_for(request, obj, request.bent_filepath)
+        if bent_out:
+            report.outputs.append(bent_out)
         report.warnings.extend(st.get("warnings", []))
         lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "
                      f"{settings.size}x{settings.size}, {settings.directions} directions in "

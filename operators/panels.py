@@ -60,6 +60,12 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.template_ID(settings, "image", new="image.new", open="image.open")
         col.prop(settings, "filepath")
         col.prop(settings, "wire_material")
+        col.prop(settings, "bent_normals")
+        sub = col.column()
+        sub.active = settings.bent_normals
+        sub.prop(settings, "bent_space")
+        sub.prop(settings, "bent_convention")
+        sub.prop(settings, "bent_filepath")
         col.prop(settings, "view_samples")
         layout.separator()
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')

@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringPropert
 from ..hao_addon import compat
 from ..hao_addon.blender.bake_job import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
+from ..hao_addon.core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 from .setting_props import setting_annotations, settings_from
 
 
@@ -42,6 +43,18 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Cage Object", type=bpy.types.Object, poll=lambda _self, obj: obj.type == 'MESH',
         description="Selected to Active: rays start on this copy of the active mesh (same topology, moved "
                     "vertices) instead of the cage extrusion")
+    bent_space: EnumProperty(
+        name="Space", description="The space the bent normals are written in",
+        items=tuple((c.value, c.label, c.description[:1].upper() + c.description[1:]) for c in SPACE_CHOICES),
+        default=SPACE_CHOICES[0].value)
+    bent_convention: EnumProperty(
+        name="Convention", description="Which way the green channel points",
+        items=tuple((c.value, c.label, c.description[:1].upper() + c.description[1:]) for c in CONVENTION_CHOICES),
+        default=CONVENTION_CHOICES[0].value)
+    bent_filepath: StringProperty(
+        name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "
+                                                 "{object} is replaced by the object's name", default="",
+        subtype='FILE_PATH', options=compat.path_property_options())
     wire_material: BoolProperty(
         name="Add to Material", description="Add the AO image to the object's material and multiply it into Base Color",
         default=False)
@@ -60,7 +73,9 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
             targets = [active] if active is not None else []
         return BakeRequest(targets=targets, settings=self.to_settings(), occluders=self.occluders, uv_map=uv,
                            image=self.image, filepath=self.filepath, wire_material=self.wire_material,
-                           high_poly=high_poly, cage=cage)
+                           high_poly=high_poly, cage=cage,
+                           bent_filepath=self.bent_filepath if self.bent_normals else "",
+                           bent_space=self.bent_space, bent_convention=self.bent_convention)
 
 
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))

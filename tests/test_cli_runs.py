@@ -345,3 +345,19 @@ def test_high_poly_mistakes_are_one_line(dirs, extra, message):
     assert proc.returncode == 2 and proc.stderr.strip() == f"hao: error: {proc.stderr.strip()[12:]}"
     assert message in proc.stderr and len(proc.stderr.splitlines()) == 1, proc.stderr
     assert list(out.iterdir()) == [] and list(tmp.iterdir()) == []
+
+
+def test_bent_normal_out_writes_a_second_map_and_the_scatter_refuses(dirs):
+    out, tmp = dirs
+    report = out / "r.json"
+    proc = run(["bake", SPOT, "--size", "64", "--directions", "16", "--out", out / "ao.png",
+                "--bent-normal-out", out / "{object}_bent.exr", "--bent-space", "object", "--json", report,
+                "--quiet"], tmp)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(report.read_text())
+    assert data["outputs"] == [str(out / "ao.png"), str(out / "spot_bent.exr")]
+    assert data["settings"]["bent_normals"] is True and (out / "spot_bent.exr").stat().st_size > 64 * 64 * 16
+    proc = run(["bake", SPOT, "--size", "64", "--method", "scatter", "--out", out / "s.png",
+                "--bent-normal-out", out / "s_bent.png"], tmp)
+    assert proc.returncode == 2 and "scatter bakes ambient occlusion only" in proc.stderr, proc.stderr
+    assert not (out / "s.png").exists() and not (out / "s_bent.png").exists()

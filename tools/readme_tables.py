@@ -26,7 +26,7 @@ def table(*settings_classes) -> str:
     rows = ["| Setting | Option | Default | Range | What it does |", "|---|---|---|---|---|"]
     for cls in settings_classes:
         for f, spec in specs(cls):
-            option = f"`{spec.option(f.name)}`" if spec.option(f.name) else "(panel only)"
+            option = f"`{spec.option(f.name) or spec.cli_via}`" if spec.option(f.name) or spec.cli_via else "(panel only)"
             label = spec.label if spec.ui else "(command line only)"
             default = f"`{f.default}`" if not isinstance(f.default, bool) else ("on" if f.default else "off")
             what = spec.sentence

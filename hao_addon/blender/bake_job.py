@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 from typing import Generator
 
 import bpy
+import numpy as np
 
 from .. import compat
 from ..bake import BakeResult, bake_steps
@@ -20,6 +21,8 @@ from ..core.imageio import check_writable, write_ao_file
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
+from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
+from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import images, mesh_data
 from .paths import OBJECT_TOKEN, absolute_path, object_file_name
@@ -39,7 +42,10 @@ class BakeRequest:
     targets and no token, '_{object}' is appended).
     high_poly: Selected to Active (Cycles' definition): these meshes are baked onto the one
     target's UVs and occlude, the target does not; cage: an optional cage object (the
-    target's topology, moved vertices) the rays start from."""
+    target's topology, moved vertices) the rays start from.
+    Bent normals (settings.bent_normals): each target also gets an image '<object>_BentNormals'
+    in bent_space ('tangent': the baked UV map's MikkTSpace; 'object') and bent_convention
+    ('opengl' Y+, 'directx' Y-), saved to bent_filepath if given (tokens as filepath)."""
 
     targets: list
     settings: BakeSettings
@@ -52,6 +58,9 @@ class BakeRequest:
     source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None
+    bent_filepath: str = ""
+    bent_space: str = "tangent"
+    bent_convention: str = "opengl"
 
 
 def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeSettings:
@@ -65,12 +74,14 @@ def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeS
     return replace(settings, terminator_offset=max(offsets)) if offsets else settings
 
 
-def output_path_for(request: BakeRequest, obj) -> str:
-    """The file an object's map is saved to: '{object}' becomes its name; with several targets
-    and no token, '_{object}' is added before the extension."""
-    if not request.filepath:
+def output_path_for(request: BakeRequest, obj, filepath: str | None = None) -> str:
+    """The file an object's map is saved to (request.filepath, or the given one): '{object}'
+    becomes its name; with several targets and no token, '_{object}' is added before the
+    extension."""
+    filepath = request.filepath if filepath is None else filepath
+    if not filepath:
         return ""
-    path = absolute_path(request.filepath)
+    path = absolute_path(filepath)
     if len(request.targets) > 1 and OBJECT_TOKEN not in path:
         stem, ext = os.path.splitext(path)
         path = f"{stem}_{OBJECT_TOKEN}{ext}"
@@ -100,17 +111,24 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
     if request.image is not None and len(request.targets) > 1:
         raise BakeInputError("an existing image can receive only one object's bake")
+    if request.bent_filepath and not request.settings.bent_normals:
+        raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
+    if request.bent_space not in SPACES or request.bent_convention not in CONVENTIONS:
+        raise BakeInputError(f"bent normals: space must be one of {SPACES}, convention one of {CONVENTIONS}")
     writers: dict[str, str] = {}
+    size = request.settings.size
     for obj in request.targets:
-        path = output_path_for(request, obj)
-        if not path:
-            continue
-        if path in writers:
-            raise BakeInputError(f"'{writers[path]}' and '{obj.name}' would both be saved as '{path}': "
-                                 f"rename one of them")
-        writers[path] = obj.name
-        size = request.settings.size
-        check_writable(path, size, size, 1, source=request.source_path or None)
+        for filepath, channels in ((request.filepath, 1), (request.bent_filepath, 4)):
+            path = output_path_for(request, obj, filepath)
+            if not path:
+                continue
+            if path in writers:
+                raise BakeInputError(f"'{writers[path]}' and '{obj.name}' would both be saved as '{path}': "
+                                     f"rename one of them" if writers[path] != obj.name else
+                                     f"the AO map and the bent normals of '{obj.name}' would both be saved as "
+                                     f"'{path}'")
+            writers[path] = obj.name
+            check_writable(path, size, size, channels, source=request.source_path or None)
 
 
 def _validate_high_to_low(request: BakeRequest) -> None:
@@ -152,6 +170,7 @@ class BakeJob:
         self._depsgraph_getter = depsgraph_getter
         self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
+        self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.committed: list[bpy.types.Image] = []
         self.finished = False
         self.unwrap_seconds = 0.0
@@ -235,8 +254,23 @@ class BakeJob:
                     yield (k + frac) / n, f"Baking AO of '{obj.name}' ({k + 1}/{n}): {frac * 100:.0f}%"
             finally:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
+            if settings.bent_normals:
+                self.bent_images[obj.name] = self._bent_image(obj, depsgraph, uv_names[obj.name], target, result)
             self.results.append((obj, uv_names[obj.name], result))
         self.finished = True
+
+    def _bent_image(self, obj, depsgraph, uv_name: str, target, result: BakeResult):
+        """(size, size, 4) encoded bent-normal image of a finished bake, in the request's space."""
+        req = self.request
+        linear = np.array(obj.evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
+        tangents = normals = None
+        if req.bent_space == "tangent":
+            tangents = mesh_data.corner_tangents(obj, depsgraph, uv_name)
+            normals = target.normals
+            if normals is None:  # flat shading: every corner has its face's normal
+                normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
+        return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin, target.uvs,
+                               req.bent_space, req.bent_convention, linear, tangents, normals)
 
     def run(self) -> None:
         for _ in self.steps():
@@ -252,15 +286,22 @@ class BakeJob:
             path = output_path_for(req, obj)
             if path:
                 write_ao_file(path, result.ao)
+            bent_path = output_path_for(req, obj, req.bent_filepath)
+            if bent_path:
+                write_ao_file(bent_path, self.bent_images[obj.name])
         for obj, uv_name, result in self.results:
             name = req.image_name or f"{obj.name}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
             existing = req.image or bpy.data.images.get(name)
-            image = images.store_ao_image(result.ao, name, existing)
+            image = images.store_map_image(result.ao, name, existing)
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
             self.committed.append(image)
+            if obj.name in self.bent_images:
+                name = f"{obj.name}_BentNormals"
+                self.committed.append(images.store_map_image(self.bent_images[obj.name], name,
+                                                             bpy.data.images.get(name)))
         return self.committed
 
     def cancel(self) -> None:
@@ -271,3 +312,4 @@ class BakeJob:
                 mesh.uv_layers.remove(layer)
         self.created_uv.clear()
         self.results.clear()
+        self.bent_images.clear()

@@ -9,10 +9,11 @@ AO_NODE_LABEL = "HAO AO"
 AO_MIX_LABEL = "HAO AO Multiply"
 
 
-def store_ao_image(ao: np.ndarray, name: str, existing: bpy.types.Image | None = None) -> bpy.types.Image:
-    """Put (H, W) accessibility (row 0 = bottom) into a float image datablock, grey RGB with
-    alpha 1, colour space Non-Color (AO is data, not colour)."""
-    h, w = ao.shape
+def store_map_image(pixels: np.ndarray, name: str, existing: bpy.types.Image | None = None) -> bpy.types.Image:
+    """Put a baked map (row 0 = bottom) into a float image datablock, colour space Non-Color
+    (AO and normals are data, not colour): (H, W) accessibility as grey RGB with alpha 1, or
+    (H, W, 4) RGBA as it is (an encoded bent-normal map)."""
+    h, w = pixels.shape[:2]
     image = existing
     if image is None:
         image = bpy.data.images.new(name, w, h, alpha=False, float_buffer=True)
@@ -28,8 +29,11 @@ def store_ao_image(ao: np.ndarray, name: str, existing: bpy.types.Image | None =
         raise RuntimeError(f"image '{image.name}' could not be resized to {w}x{h}")
     image.colorspace_settings.name = 'Non-Color'
     rgba = np.empty((h, w, 4), dtype=np.float32)
-    rgba[..., :3] = ao[..., None]
-    rgba[..., 3] = 1.0
+    if pixels.ndim == 3:
+        rgba[...] = pixels
+    else:
+        rgba[..., :3] = pixels[..., None]
+        rgba[..., 3] = 1.0
     image.pixels.foreach_set(rgba.ravel())
     image.update()
     return image

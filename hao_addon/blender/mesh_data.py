@@ -5,6 +5,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from ..core.errors import BakeInputError
 from ..core.geometry import TriangleSoup
 
 AO_UV_NAME = "AO_UV"
@@ -70,6 +71,38 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
             normal_matrix = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-300 else linear
             normals = corner_normals(mesh)[tri_loops] @ normal_matrix.T
         return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals)
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def corner_tangents(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str) -> np.ndarray:
+    """(F, 3, 4) float64 MikkTSpace tangent (world space) and bitangent sign of every corner of
+    the evaluated mesh's UV map, in evaluated_soup's corner order: what Blender's Normal Map
+    node decodes tangent-space maps with. A mirroring transform flips the sign (Blender's
+    shader multiplies the bitangent by the object's negative-scale sign). Raises
+    BakeInputError for faces of more than four corners (Mesh.calc_tangents refuses them)."""
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        _co, _tri_verts, tri_loops = _mesh_arrays(mesh)
+        linear = np.array(obj_eval.matrix_world, dtype=np.float64)[:3, :3]
+        mirrored = np.linalg.det(linear) < 0.0
+        if mirrored:
+            tri_loops = tri_loops[:, ::-1]
+        try:
+            mesh.calc_tangents(uvmap=uv_name)
+        except RuntimeError as err:
+            raise BakeInputError(f"'{obj.name}': tangent-space bent normals need faces of 3 or 4 corners "
+                                 f"(triangulate the n-gons, or bake them in object space): {err}") from None
+        tangent = np.empty(len(mesh.loops) * 3, np.float32)
+        mesh.loops.foreach_get("tangent", tangent)
+        sign = np.empty(len(mesh.loops), np.float32)
+        mesh.loops.foreach_get("bitangent_sign", sign)
+        mesh.free_tangents()
+        out = np.empty(tri_loops.shape + (4,))
+        out[..., :3] = tangent.reshape(-1, 3).astype(np.float64)[tri_loops] @ linear.T
+        out[..., 3] = sign[tri_loops] * (-1.0 if mirrored else 1.0)
+        return out
     finally:
         obj_eval.to_mesh_clear()
 

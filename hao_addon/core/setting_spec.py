@@ -27,7 +27,8 @@ class Spec:
     it (default: the label in lower case). minimum/maximum: inclusive bounds (None: open);
     above_minimum: the minimum itself is excluded. soft_max: the UI slider's end. unit: shown
     in messages and tables. subtype: Blender's property subtype. cli: the option name ('' =
-    --field-name, None = not on the command line). ui: has a Blender property."""
+    --field-name, None = not on the command line). cli_via: with cli None, the command-line
+    option that turns the setting on (documented, not generated). ui: has a Blender property."""
 
     label: str
     description: str
@@ -40,6 +41,7 @@ class Spec:
     choices: tuple[Choice, ...] = ()
     subtype: str = ""
     cli: str | None = ""
+    cli_via: str = ""
     ui: bool = True
 
     @property

@@ -158,7 +158,11 @@ def views_per_dispatch(plan: BakePlan) -> int:
 
 
 # The accumulator image of an estimator's sums, by channel count (gpu_shaders/bake_estimator.glsl).
-ACCUM_FORMATS = {2: 'RG32F', 4: 'RGBA32F'}
+# Their names in the shader: "accum", then "accum_high" (bindings ACCUM_BINDINGS).
+ACCUM_FORMATS = {2: ('RG32F',), 4: ('RGBA32F',), 8: ('RGBA32F', 'RGBA32F')}
+ACCUM_NAMES = ("accum", "accum_high")
+FORMAT_CHANNELS = {'RG32F': 2, 'RGBA32F': 4}
+ACCUM_BINDINGS = (2, 6)
 
 
 def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool,
@@ -191,7 +195,8 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
     info.uniform_buf(0, "GatherViews", "views")
     info.image(0, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'READ'})
-    info.image(2, ACCUM_FORMATS[estimator.channel_count], 'FLOAT_2D', "accum", qualifiers={'READ', 'WRITE'})
+    for binding, name, fmt in zip(ACCUM_BINDINGS, ACCUM_NAMES, ACCUM_FORMATS[estimator.channel_count]):
+        info.image(binding, fmt, 'FLOAT_2D', name, qualifiers={'READ', 'WRITE'})
     if falloff is None:
         for k in range(views):
             info.sampler(k, 'FLOAT_2D', f"depth_tex{k}")
@@ -336,8 +341,9 @@ class GatherBaker(LightViewBaker):
             if len(uploaded) > 2:
                 self.entry_lift = texture(uploaded[2])
         channels = self.plan.estimator.channel_count
-        self.accum = gpu.types.GPUTexture(shape, format=ACCUM_FORMATS[channels])
-        self.accum.clear(format='FLOAT', value=(0.0,) * channels)
+        self.accums = [gpu.types.GPUTexture(shape, format=fmt) for fmt in ACCUM_FORMATS[channels]]
+        for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels]):
+            accum.clear(format='FLOAT', value=(0.0,) * FORMAT_CHANNELS[fmt])
 
     def _upload_texel_list(self, receivers: Receivers) -> None:
         """The list from CPU receivers: sorted by the normal bin of their shading normal (the
@@ -418,7 +424,8 @@ class GatherBaker(LightViewBaker):
         self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
         self.pending = []
         self.chunks = None
-        self.entry_position = self.entry_normal = self.entry_texel = self.entry_lift = self.accum = None
+        self.entry_position = self.entry_normal = self.entry_texel = self.entry_lift = None
+        self.accums = []
         self.receivers = self.entry_texels = None
         super()._release()
 
@@ -491,7 +498,8 @@ class GatherBaker(LightViewBaker):
                 shader.uniform_sampler(f"depth_tex{k}", self.depths[k])
         shader.image("entry_position", self.entry_position)
         shader.image("entry_normal", self.entry_normal)
-        shader.image("accum", self.accum)
+        for name, accum in zip(ACCUM_NAMES, self.accums):
+            shader.image(name, accum)
         if self.lifted:
             shader.image("entry_lift", self.entry_lift)
             shader.uniform_float("terminator_offset", settings.terminator_offset)
@@ -519,7 +527,9 @@ class GatherBaker(LightViewBaker):
         channels = self.plan.estimator.channel_count
         if n == 0:
             return np.zeros((size, size, channels))
-        sums = util.texture_to_numpy(self.accum, np.float32).reshape(-1, channels)[:n].astype(np.float64)
+        parts = [util.texture_to_numpy(accum, np.float32).reshape(-1, FORMAT_CHANNELS[fmt])[:n]
+                 for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels])]
+        sums = np.concatenate(parts, axis=1).astype(np.float64)
         if self.receivers is not None:
             flat = self.entry_texels
         else:

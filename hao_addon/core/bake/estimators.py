@@ -59,7 +59,39 @@ class AmbientOcclusion(Estimator):
         return sums[..., 0], sums[..., 1]
 
 
+class BentNormals(Estimator):
+    """Accessibility and the bent normal from one set of sums: sum(w V) and sum(w V omega)
+    (the cosine-weighted mean unoccluded direction), sum(w omega) (the same mean over the whole
+    hemisphere: the fallback direction where every direction is blocked) and sum(w)."""
+
+    def __init__(self) -> None:
+        super().__init__("ambient occlusion and bent normals",
+                         ("visible_weight", "bent_x", "bent_y", "bent_z", "open_x", "open_y", "open_z", "weight"),
+                         "ESTIMATOR_BENT_NORMALS")
+
+    def terms(self, weight: np.ndarray, visible: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        seen = weight * visible
+        omega = np.asarray(omega, np.float64)
+        return np.concatenate([seen[:, None], seen[:, None] * omega, weight[:, None] * omega, weight[:, None]],
+                              axis=1)
+
+    def ratio(self, sums: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return sums[..., 0], sums[..., 7]
+
+    def bent(self, sums: np.ndarray) -> np.ndarray:
+        """(..., 3) float64 unit bent normals from sums (..., 8), in the directions' space:
+        sum(w V omega) normalized, or sum(w omega) normalized where nothing is visible; zero
+        where no direction has weight."""
+        return _unit(np.where((sums[..., 0] > 0.0)[..., None], sums[..., 1:4], sums[..., 4:7]))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.divide(v, length, out=np.zeros_like(v), where=length > 0.0)
+
+
 AMBIENT_OCCLUSION = AmbientOcclusion()
+BENT_NORMALS = BentNormals()
 
 
 def texel_sums(texel: np.ndarray, sums: np.ndarray, size: int) -> np.ndarray:

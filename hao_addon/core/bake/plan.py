@@ -16,7 +16,7 @@ from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
-from .estimators import AMBIENT_OCCLUSION, Estimator
+from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, check_high_to_low, drain, projected_receivers_steps
 from .receivers import Receivers, uv_receivers
@@ -89,8 +89,8 @@ class BakePlan:
     @property
     def estimator(self) -> Estimator:
         """What each direction adds to a receiver's sums (core/bake/estimators.py): ambient
-        occlusion, the one output the bake has today."""
-        return AMBIENT_OCCLUSION
+        occlusion, with the bent normal's sums too where the settings ask for it."""
+        return BENT_NORMALS if self.settings.bent_normals else AMBIENT_OCCLUSION
 
     @property
     def lifts_terminator(self) -> bool:

@@ -101,3 +101,13 @@ def finalize_map(numerator: np.ndarray, coverage: np.ndarray, margin: int,
     filled &= target
     ao = np.where(filled, ao, np.float32(background))
     return ao, covered, filled
+
+
+def finalize_vectors(vectors: np.ndarray, covered: np.ndarray, filled: np.ndarray, margin: int) -> np.ndarray:
+    """(H, W, 3) float32 unit vectors (a bent-normal map): vectors (H, W, 3) where covered,
+    grown over the rim and margin as finalize_map grows the AO (each component by the same
+    neighbours, then renormalized), zero outside filled."""
+    grown = np.stack([dilate(vectors[..., c].astype(np.float32), covered, margin + 2)[0] for c in range(3)], -1)
+    length = np.linalg.norm(grown, axis=-1, keepdims=True)
+    unit = np.divide(grown, length, out=np.zeros_like(grown), where=length > 0.0)
+    return np.where(filled[..., None], unit, np.float32(0.0)).astype(np.float32)

@@ -98,6 +98,10 @@ class BakeSettings:
                     "facet start from the smooth surface its normals describe, so the triangles do not show as "
                     "dark bands; 0 = off. Used for OBJ and glTF input and with Terminator 'setting'; "
                     "the scatter ignores it")
+    bent_normals: bool = setting(
+        False, label="Bent Normals", cli=None, cli_via="--bent-normal-out FILE",
+        description="also bake the bent normal: each texel's cosine-weighted mean unoccluded direction, from "
+                    "the same directions as the AO (gather and reference; the scatter cannot)")
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
@@ -118,10 +122,10 @@ class BakeSettings:
     def method_for(self, high_to_low: bool) -> str:
         """The bake variant that runs: 'auto' is the gather, except with a max distance on the
         target's own surface, where the scatter is (the benchmark's fastest at equal error);
-        Selected to Active always gathers (the scatter cannot bake it)."""
+        Selected to Active and bent normals always gather (the scatter can bake neither)."""
         if self.method != "auto":
             return self.method
-        return "scatter" if self.max_distance > 0.0 and not high_to_low else "gather"
+        return "scatter" if self.max_distance > 0.0 and not high_to_low and not self.bent_normals else "gather"
 
     @property
     def sample_count(self) -> int:
