@@ -274,3 +274,9 @@ def boundary_edge_fraction(positions: np.ndarray) -> float:
     n = len(verts)
     _, counts = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)
     return float((counts == 1).sum() / len(counts))
+
+
+def unit_vectors(v: np.ndarray) -> np.ndarray:
+    """(..., 3) vectors scaled to unit length; zero vectors stay zero."""
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.divide(v, length, out=np.zeros_like(v), where=length > 0.0)

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import unit_vectors
+
 
 @dataclass(frozen=True)
 class Estimator:
@@ -82,12 +84,8 @@ class BentNormals(Estimator):
         """(..., 3) float64 unit bent normals from sums (..., 8), in the directions' space:
         sum(w V omega) normalized, or sum(w omega) normalized where nothing is visible; zero
         where no direction has weight."""
-        return _unit(np.where((sums[..., 0] > 0.0)[..., None], sums[..., 1:4], sums[..., 4:7]))
+        return unit_vectors(np.where((sums[..., 0] > 0.0)[..., None], sums[..., 1:4], sums[..., 4:7]))
 
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.divide(v, length, out=np.zeros_like(v), where=length > 0.0)
 
 
 AMBIENT_OCCLUSION = AmbientOcclusion()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import unit_vectors
 from ..setting_spec import Choice
 
 # The output's choices, one definition for the panel (operators/properties.py) and the CLI.
@@ -26,10 +27,6 @@ CONVENTION_CHOICES = (
 SPACES = tuple(c.value for c in SPACE_CHOICES)
 CONVENTIONS = tuple(c.value for c in CONVENTION_CHOICES)
 
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.divide(v, length, out=np.zeros_like(v), where=length > 0.0)
 
 
 def tangent_frames(face: np.ndarray, bary: np.ndarray, tangents: np.ndarray, normals: np.ndarray
@@ -54,14 +51,14 @@ def to_tangent_space(vectors: np.ndarray, frames: np.ndarray) -> np.ndarray:
     ok = np.abs(det) > 1e-12
     out = np.tile([0.0, 0.0, 1.0], (len(vectors), 1))
     if ok.any():
-        out[ok] = _unit(np.linalg.solve(basis[ok], vectors[ok][..., None])[..., 0])
+        out[ok] = unit_vectors(np.linalg.solve(basis[ok], vectors[ok][..., None])[..., 0])
     return out
 
 
 def to_object_space(vectors: np.ndarray, linear: np.ndarray) -> np.ndarray:
     """(..., 3) unit world normals -> the object's space of linear map (3, 3) (object to
     world): normals map to world with the inverse transpose, so back with the transpose."""
-    return _unit(np.asarray(vectors, np.float64) @ np.asarray(linear, np.float64))
+    return unit_vectors(np.asarray(vectors, np.float64) @ np.asarray(linear, np.float64))
 
 
 def encode(vectors: np.ndarray, convention: str = "opengl") -> np.ndarray:
