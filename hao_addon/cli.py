@@ -68,6 +68,9 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--bent-normal-out", default="", metavar="FILE",
                    help="also bake bent normals (the cosine-weighted mean unoccluded direction, same pass) into "
                         "this .png (16-bit) or .exr (32-bit float) RGB file, 0.5 + 0.5 n; {object} as in --out")
+    b.add_argument("--gltf-out", default="", metavar="FILE.glb",
+                   help="also write the baked object as a .glb with the map as its material's occlusionTexture "
+                        "(Blender's glTF exporter; the map on the UV map that was baked)")
     for option, choices in (("--bent-space", SPACE_CHOICES), ("--bent-convention", CONVENTION_CHOICES)):
         b.add_argument(option, choices=[c.value for c in choices], default=choices[0].value,
                        help="; ".join(f"{c.value}: {c.description}" for c in choices) + f" (default {choices[0].value})")
@@ -210,6 +213,38 @@ def _mesh_names() -> str:
     return ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
 
 
+def check_gltf_target(path: str, source: Path) -> Path:
+    """The --gltf-out file, refused before any work unless it is a .glb in a writable folder
+    and not the input."""
+    out = Path(os.path.abspath(path))
+    if out.suffix.lower() != ".glb":
+        raise CLIError(f"--gltf-out must be a .glb file (one file, written atomically), got '{path}'")
+    if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
+        raise CLIError(f"cannot write '{out}': its folder does not exist or is not writable")
+    if out.exists() and out.resolve() == source.resolve():
+        raise CLIError(f"--gltf-out '{out}' is the input file")
+    return out
+
+
+def export_glb(obj, path: Path) -> None:
+    """Write obj alone as a .glb with Blender's glTF exporter, atomically (a temporary file in
+    the same folder, renamed over path)."""
+    import bpy
+
+    for other in bpy.context.view_layer.objects:
+        other.select_set(other == obj)
+    bpy.context.view_layer.objects.active = obj
+    tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}.glb")
+    try:
+        result = bpy.ops.export_scene.gltf(filepath=str(tmp), export_format='GLB', use_selection=True)
+        if result != {'FINISHED'} or not tmp.is_file():
+            raise CLIError(f"the glTF export of '{obj.name}' failed")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
 def pick_target(name: str, exclude: tuple = ()):
     """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
     import bpy
@@ -244,6 +279,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         settings = replace(settings, bent_normals=True)
         check_writable(args.bent_normal_out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 4,
                        source=source)
+    gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     report.input = str(source)
     # Refused before a long load; checked again with the object's name once it is known.
@@ -267,7 +303,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                           filepath=str(Path(os.path.abspath(args.out))), source_path=str(source),
                           high_poly=high_poly, cage=cage,
                           bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
-                          bent_space=args.bent_space, bent_convention=args.bent_convention)
+                          bent_space=args.bent_space, bent_convention=args.bent_convention,
+                          wire_material=gltf_out is not None)
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     start_gpu()
     t0 = time.perf_counter()
@@ -278,6 +315,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         check_signals()  # never commit a run that was asked to stop
         with report.phase("write"):
             job.commit()
+            if gltf_out is not None:
+                export_glb(target, gltf_out)
     except BaseException:
         job.cancel()
         raise
@@ -295,6 +334,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         bent_out = output_path_for(request, obj, request.bent_filepath)
         if bent_out:
             report.outputs.append(bent_out)
+        if gltf_out is not None:
+            report.outputs.append(str(gltf_out))
         report.warnings.extend(st.get("warnings", []))
         lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "
                      f"{settings.size}x{settings.size}, {settings.directions} directions in "

@@ -7,6 +7,40 @@ import numpy as np
 
 AO_NODE_LABEL = "HAO AO"
 AO_MIX_LABEL = "HAO AO Multiply"
+# The node group Blender's glTF exporter reads the Occlusion input of (io_scene_gltf2:
+# get_socket_from_gltf_material_node matches group names starting with this, any case), and
+# writes as the material's occlusionTexture on the UV map of the image's UV Map node.
+GLTF_OUTPUT_GROUP = "glTF Material Output"
+GLTF_OCCLUSION = "Occlusion"
+
+
+def gltf_output_group() -> bpy.types.NodeTree:
+    """The 'glTF Material Output' node group with its Occlusion input (made as the glTF
+    importer makes it where the file has none)."""
+    group = next((g for g in bpy.data.node_groups
+                  if g.bl_idname == 'ShaderNodeTree' and g.name.lower().startswith(GLTF_OUTPUT_GROUP.lower())), None)
+    if group is None:
+        group = bpy.data.node_groups.new(GLTF_OUTPUT_GROUP, 'ShaderNodeTree')
+    inputs = {item.name for item in group.interface.items_tree
+              if item.item_type == 'SOCKET' and item.in_out == 'INPUT'}
+    if GLTF_OCCLUSION not in inputs:
+        group.interface.new_socket(GLTF_OCCLUSION, in_out='INPUT', socket_type='NodeSocketFloat')
+    return group
+
+
+def wire_gltf_occlusion(tree: bpy.types.NodeTree, tex: bpy.types.Node) -> None:
+    """Connect the AO image node to the Occlusion input of the material's glTF Material
+    Output node (added once), so that glTF export writes it as occlusionTexture."""
+    group = gltf_output_group()
+    node = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeGroup' and n.node_tree == group), None)
+    if node is None:
+        node = tree.nodes.new('ShaderNodeGroup')
+        node.node_tree = group
+        node.label = GLTF_OUTPUT_GROUP
+        node.location = (tex.location.x + 300, tex.location.y + 250)
+    socket = node.inputs[GLTF_OCCLUSION]
+    if not any(link.from_node == tex for link in socket.links):
+        tree.links.new(tex.outputs["Color"], socket)
 
 
 def store_map_image(pixels: np.ndarray, name: str, existing: bpy.types.Image | None = None) -> bpy.types.Image:
@@ -49,8 +83,9 @@ def image_pixels_gray(image: bpy.types.Image) -> np.ndarray:
 
 def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str) -> bpy.types.Material:
     """Add an Image Texture node with the AO map (through a UV Map node) to the object's
-    active material, make it the active node, and multiply it into the Principled BSDF's
-    Base Color once. A material is created when the object has none."""
+    active material, make it the active node, multiply it into the Principled BSDF's Base
+    Color once and connect it to the glTF Material Output's Occlusion (what glTF export
+    writes as occlusionTexture). A material is created when the object has none."""
     mat = obj.active_material
     if mat is None:
         mat = bpy.data.materials.new(f"{obj.name}_HAO")
@@ -73,6 +108,7 @@ def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: s
                 link.from_node.uv_map = uv_name
     tex.image = image
     tree.nodes.active = tex
+    wire_gltf_occlusion(tree, tex)
     bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
     has_mix = any(n.label == AO_MIX_LABEL for n in tree.nodes)
     if bsdf is not None and not has_mix:
