@@ -39,7 +39,7 @@ def test_zip_contains_the_extension_and_no_dev_files(built_zip):
                      "hao_addon/gpu/bake_scatter.py", "gpu_shaders/bake_splat.frag",
                      "wheels/xatlas-0.0.11-cp311-cp311-win_amd64.whl"):
         assert required in names, required
-    assert not any(n.startswith(("tests/", "bench/", ".venv/", ".ci/")) for n in names)
+    assert not any(n.startswith(("tests/", "bench/", "docs/", ".venv/", ".ci/")) for n in names)
 
 
 def test_installed_zip_bakes(built_zip, tmp_path):

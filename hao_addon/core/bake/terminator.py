@@ -41,19 +41,23 @@ def smooth_surface_lift(triangles: np.ndarray, corner_normals: np.ndarray, bary:
     b = _dot(n2 - n1, v1 - v2)
     c = _dot(n1 - n0, v1 - v0)
     h = a * u * (u - 1.0) + (a + b + c) * u * v + b * v * (v - 1.0)
-    zero = np.zeros_like(h)
 
-    def envelope(sign: float) -> np.ndarray:
-        """Local linear envelope: the lowest of the corners' tangent planes over p (sign +1),
-        or of their planes below it (sign -1, flipped normals)."""
+    def envelope(sign: float, at: np.ndarray) -> np.ndarray:
+        """Local linear envelope at the points `at` (indices): the lowest of the corners'
+        tangent planes over p (sign +1), or of their planes below it (sign -1, flipped
+        normals). Each side is evaluated only where it is used (half the work)."""
         heights = []
         for vk, nk, others in ((v0, n0, (v1, v2)), (v1, n1, (v0, v2)), (v2, n2, (v0, v1))):
-            reach = np.maximum(np.maximum(sign * _dot(others[0] - vk, nk), sign * _dot(others[1] - vk, nk)), zero)
-            heights.append(np.maximum(sign * _dot(vk - p, nk) + reach, zero))
+            vk, nk, o0, o1 = vk[at], nk[at], others[0][at], others[1][at]
+            reach = np.maximum(np.maximum(sign * _dot(o0 - vk, nk), sign * _dot(o1 - vk, nk)), 0.0)
+            heights.append(np.maximum(sign * _dot(vk - p[at], nk) + reach, 0.0))
         return np.minimum(np.minimum(heights[0], heights[1]), heights[2])
 
     facing = _dot(n, geometric) > 0.0
-    lifted = np.where(facing, np.maximum(envelope(1.0), 0.5 * h), np.minimum(-envelope(-1.0), 0.5 * h))
+    up, down = np.flatnonzero(facing), np.flatnonzero(~facing)
+    lifted = np.empty_like(h)
+    lifted[up] = np.maximum(envelope(1.0, up), 0.5 * h[up])
+    lifted[down] = np.minimum(-envelope(-1.0, down), 0.5 * h[down])
     return n * lifted[:, None]
 
 
