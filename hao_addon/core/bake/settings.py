@@ -27,8 +27,8 @@ NORMALS_CHOICES = (
     Choice("face", "Face", "flat: every texel uses its triangle's normal"),
 )
 METHOD_CHOICES = (
-    Choice("auto", "Auto", "the gather for unlimited distance and Selected to Active (fastest at equal error in "
-                           "the benchmark), the scatter with a max distance"),
+    Choice("auto", "Auto", "the gather for unlimited distance, Selected to Active and bent normals (fastest at "
+                           "equal error in the benchmark), otherwise the scatter with a max distance"),
     Choice("scatter", "Histogram Scatter", "McGraw & Sowers: texel-area average; supports max distance and falloff"),
     Choice("gather", "Shadow-Map Gather", "shadow maps sampled at texel centres (the paper's baseline); with a "
                                           "max distance, per-pixel depth lists"),
