@@ -319,8 +319,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                 try:
                     export_glb(target, gltf_out)
                 except BaseException:  # all or nothing: the maps just written go too
-                    for path in (output_path_for(request, target), output_path_for(request, target, request.bent_filepath)):
-                        if path and os.path.exists(path):
+                    for path in job.written:
+                        if os.path.exists(path):
                             os.unlink(path)
                     raise
     except BaseException:

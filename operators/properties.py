@@ -8,7 +8,7 @@ from ..hao_addon import compat
 from ..hao_addon.blender.bake_job import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
 from ..hao_addon.core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
-from .setting_props import setting_annotations, settings_from
+from .setting_props import enum_items, setting_annotations, settings_from
 
 
 class HAO_PG_bake_settings(bpy.types.PropertyGroup):
@@ -45,11 +45,11 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                     "vertices) instead of the cage extrusion")
     bent_space: EnumProperty(
         name="Space", description="The space the bent normals are written in",
-        items=tuple((c.value, c.label, c.description[:1].upper() + c.description[1:]) for c in SPACE_CHOICES),
+        items=enum_items(SPACE_CHOICES),
         default=SPACE_CHOICES[0].value)
     bent_convention: EnumProperty(
         name="Convention", description="Which way the green channel points",
-        items=tuple((c.value, c.label, c.description[:1].upper() + c.description[1:]) for c in CONVENTION_CHOICES),
+        items=enum_items(CONVENTION_CHOICES),
         default=CONVENTION_CHOICES[0].value)
     bent_filepath: StringProperty(
         name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "

@@ -29,14 +29,18 @@ def tooltip(text: str) -> str:
     return text[:1].upper() + text[1:]
 
 
+def enum_items(choices) -> tuple:
+    """EnumProperty items of core Choice definitions."""
+    return tuple((c.value, c.label, tooltip(c.description)) for c in choices)
+
+
 def blender_property(field, spec, update=None):
     """The bpy.props definition of one setting."""
     kw = {"name": spec.label, "description": spec.sentence, "default": field.default}
     if update is not None:
         kw["update"] = update
     if spec.choices:
-        items = tuple((c.value, c.label, tooltip(c.description)) for c in spec.choices)
-        return EnumProperty(items=items, **kw)
+        return EnumProperty(items=enum_items(spec.choices), **kw)
     if isinstance(field.default, bool):
         return BoolProperty(**kw)
     low, high = spec.minimum, spec.maximum

@@ -171,6 +171,7 @@ class BakeJob:
         self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
+        self.written: list[str] = []  # the files commit() wrote
         self.committed: list[bpy.types.Image] = []
         self.finished = False
         self.unwrap_seconds = 0.0
@@ -266,6 +267,8 @@ class BakeJob:
         tangents = normals = None
         if req.bent_space == "tangent":
             tangents = mesh_data.corner_tangents(obj, depsgraph, uv_name)
+            # The world corner normals as they are (not re-normalized: on a scaled object that
+            # would turn the decoded direction, 4 degrees on tests/test_bent_normals' sphere).
             normals = target.normals
             if normals is None:  # flat shading: every corner has its face's normal
                 normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
@@ -286,9 +289,11 @@ class BakeJob:
             path = output_path_for(req, obj)
             if path:
                 write_ao_file(path, result.ao)
+                self.written.append(path)
             bent_path = output_path_for(req, obj, req.bent_filepath)
             if bent_path:
                 write_ao_file(bent_path, self.bent_images[obj.name])
+                self.written.append(bent_path)
         for obj, uv_name, result in self.results:
             name = req.image_name or f"{obj.name}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import unit_vectors
+
 MIN_COVERAGE = 0.5
 _OFFSETS = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
 
@@ -108,6 +110,4 @@ def finalize_vectors(vectors: np.ndarray, covered: np.ndarray, filled: np.ndarra
     grown over the rim and margin as finalize_map grows the AO (each component by the same
     neighbours, then renormalized), zero outside filled."""
     grown = np.stack([dilate(vectors[..., c].astype(np.float32), covered, margin + 2)[0] for c in range(3)], -1)
-    length = np.linalg.norm(grown, axis=-1, keepdims=True)
-    unit = np.divide(grown, length, out=np.zeros_like(grown), where=length > 0.0)
-    return np.where(filled[..., None], unit, np.float32(0.0)).astype(np.float32)
+    return np.where(filled[..., None], unit_vectors(grown), np.float32(0.0)).astype(np.float32)
