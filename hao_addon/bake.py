@@ -87,8 +87,13 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True},
                           cached.bent_normals)
 
+    from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
+    method = settings.method_for(high_to_low is not None)
     share = PROJECTION_PROGRESS_SHARE if high_to_low is not None else 0.0
-    planning = make_plan_steps(target, occluders, settings, high_to_low)
+    # The method's own ray cast (an unknown method is refused by the plan's validation).
+    cast = ray_caster_for(method) if high_to_low is not None and method in BAKE_METHODS else None
+    cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
+    planning = make_plan_steps(target, occluders, settings, high_to_low, cast)
     try:
         while True:
             try:
@@ -99,8 +104,6 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
             yield share * fraction
     finally:
         planning.close()  # cancelled during the projection: stop it there
-    from .bakers import baker_for  # deferred: importing gpu passes needs a GPU context only when baking
-    method = settings.method_for(high_to_low is not None)
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
@@ -118,7 +121,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
     bent = None
     if plan.estimator is BENT_NORMALS:
         bent = finalize_vectors(BENT_NORMALS.bent(sums), covered, filled, settings.margin)
-    stats = {**plan.stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
+    stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "seconds": time.perf_counter() - t0, "cache_hit": False}
     result = BakeResult(ao, covered, filled, stats, bent)
     if key is not None:

@@ -2,7 +2,9 @@
 """The one factory of bake passes: a method name -> its baker class. Every baker takes a
 BakePlan and offers check_limits(plan), run_direction(i), accumulated() -> (size, size,
 channels) the sums of the plan's estimator (core/bake/estimators.py), stats and free(); the
-tests run each on the same scenes."""
+tests run each on the same scenes. And the ray cast of a method's Selected-to-Active
+projection: the GPU's for the GPU bakers, mathutils' BVH for the reference (twins, same
+signature: core/bake/projection.project_steps)."""
 from __future__ import annotations
 
 BAKE_METHODS = ("scatter", "gather", "reference")
@@ -23,3 +25,27 @@ def baker_for(method: str):
         return ScatterBaker
     from .gpu.bake_gather import GatherBaker
     return GatherBaker
+
+
+RAY_CASTS = ("cpu", "gpu")
+
+
+def ray_cast_name(method: str) -> str:
+    """'cpu' (mathutils' BVH) for the reference and 'cpu', 'gpu' (the grid walk of
+    gpu/bake_ray_cast.py) for the GPU bakers and 'gpu'."""
+    if method not in (*BAKE_METHODS, *RAY_CASTS):
+        raise ValueError(f"unknown bake method '{method}', expected one of {BAKE_METHODS}")
+    return "cpu" if method in ("reference", "cpu") else "gpu"
+
+
+def ray_caster_for(method: str):
+    """The Selected-to-Active ray cast (projection.RayCast) that `method` (a bake method or
+    one of RAY_CASTS) plans with."""
+    if ray_cast_name(method) == "cpu":
+        import bpy  # noqa: F401 - the bpy module makes mathutils (the CPU cast's BVH) importable
+        from .core.bake.projection import project_steps
+        return project_steps
+    from .gpu.context import ensure_gpu_context
+    ensure_gpu_context()
+    from .gpu.bake_ray_cast import project_steps
+    return project_steps

@@ -15,13 +15,15 @@ import pytest
 import shading_scenes as cases
 from bake_helpers import assert_within_sample_tolerance, error_stats
 from hao_addon.bake import HighToLow, bake
+from hao_addon.bakers import RAY_CASTS, ray_caster_for
 from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.bake.projection import barycentric, project, ray_starts
+from hao_addon.core.bake.projection import barycentric, drain, ray_starts
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.gpu.util import live_pass_count
 
 BACKENDS = ["gather", "reference"]
 R = 0.5  # the relief: a ball of radius R resting on a wide floor at z = 0
@@ -126,17 +128,21 @@ def test_extrusion_follows_the_object_scale_as_in_blender():
     np.testing.assert_allclose(dirs, [[0, 0, -1.0]] * 2)
 
 
-def test_rays_hit_front_and_back_faces_within_the_max_ray_distance():
-    """As Blender's BVH ray cast: either side of a triangle is hit; a hit farther than the
-    max ray distance from the start is a miss; a zero direction finds nothing."""
+@pytest.mark.parametrize("cast_name", RAY_CASTS)
+def test_rays_hit_front_and_back_faces_within_the_max_ray_distance(gpu_context, cast_name):
+    """As Blender's BVH ray cast (and its GPU twin): either side of a triangle is hit; a hit
+    farther than the max ray distance from the start is a miss; a zero direction finds nothing."""
+    cast = ray_caster_for(cast_name)
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)  # facing +z
     origins = np.array([[0.2, 0.2, -1.0], [0.2, 0.2, 1.0], [0.2, 0.2, 1.0], [0.2, 0.2, 1.0]])
     dirs = np.array([[0, 0, 1.0], [0, 0, -1.0], [0, 0, -1.0], [0, 0, 0.0]])
-    face, bary = project(origins[:2], dirs[:2], tri, 0.0)
+    face, bary = drain(cast(origins[:2], dirs[:2], tri, 0.0))
     assert face.tolist() == [0, 0]
     np.testing.assert_allclose(bary, [[0.6, 0.2, 0.2]] * 2, atol=1e-6)
-    face, _ = project(origins[2:], dirs[2:], tri, 0.9)
+    face, _ = drain(cast(origins[2:], dirs[2:], tri, 0.9))
     assert face.tolist() == [-1, -1]
+    face, _ = drain(cast(origins[1:3], dirs[1:3], tri, 1.001))  # just within the max distance
+    assert face.tolist() == [0, 0]
 
 
 def test_barycentric_recovers_points():
@@ -250,16 +256,21 @@ def test_selected_to_active_with_a_max_distance(gpu_context, method, falloff):
         assert_within_sample_tolerance(error_stats(res.ao, ref.ao, interior & (r > R + 0.05)), 256, "vs reference")
 
 
-def test_projection_draws_progress_and_stops_when_cancelled(gpu_context, monkeypatch):
-    """The projection casts its rays in steps (core/bake/projection.py, RAYS_PER_STEP): the bake
-    yields progress within its projection share after each, and closing it there (a modal
-    bake's Esc) stops before the next step, with nothing allocated on the GPU yet."""
+@pytest.mark.parametrize("cast_name", RAY_CASTS)
+def test_projection_draws_progress_and_stops_when_cancelled(gpu_context, monkeypatch, cast_name):
+    """The projection casts its rays in steps (projection.RAYS_PER_STEP on the CPU,
+    bake_ray_cast.RAYS_PER_DISPATCH on the GPU): the bake yields progress within its
+    projection share after each, and closing it there (a modal bake's Esc) stops before the
+    next step, with nothing allocated on the GPU by the baker yet."""
     import hao_addon.bake as bake_module
+    import hao_addon.bakers as bakers
     import hao_addon.core.bake.projection as projection
+    from hao_addon.gpu import bake_ray_cast
 
     monkeypatch.setattr(projection, "RAYS_PER_STEP", 1000)
+    monkeypatch.setattr(bake_ray_cast, "RAYS_PER_DISPATCH", 1000)
     cast = []  # the fraction of rays cast at each step
-    original = projection.project_steps
+    original = bakers.ray_caster_for(cast_name)
 
     def counted_steps(*args):
         steps = original(*args)
@@ -271,8 +282,8 @@ def test_projection_draws_progress_and_stops_when_cancelled(gpu_context, monkeyp
             cast.append(fraction)
             yield fraction
 
-    monkeypatch.setattr(projection, "project_steps", counted_steps)
-
+    monkeypatch.setattr(bakers, "ray_caster_for", lambda method: counted_steps)
+    passes = live_pass_count()
     steps = bake_module.bake_steps(low_plane(1.2), [], settings("gather"), use_cache=False,
                                    high_to_low=HighToLow(relief()))
     fractions = [next(steps) for _ in range(3)]
@@ -280,6 +291,7 @@ def test_projection_draws_progress_and_stops_when_cancelled(gpu_context, monkeyp
     assert fractions == sorted(fractions) and 0.0 < fractions[0] and fractions[-1] < share
     steps.close()
     assert len(cast) == 3 and cast[-1] < 1.0  # stopped mid-projection
+    assert live_pass_count() == passes  # the GPU cast freed its textures
     # Run to its end, the directions fill the rest of the bar.
     done = list(bake_module.bake_steps(low_plane(1.2), [], settings("gather"), use_cache=False,
                                        high_to_low=HighToLow(relief())))

@@ -18,7 +18,7 @@ from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_sha
                         surface_holes, uv_areas, weld)
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
-from .projection import HighToLow, check_high_to_low, drain, projected_receivers_steps
+from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
 from .receivers import Receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
@@ -171,15 +171,17 @@ def _check_finite(soup: TriangleSoup) -> None:
 
 
 def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-              high_to_low: HighToLow | None = None) -> BakePlan:
+              high_to_low: HighToLow | None = None, cast: RayCast | None = None) -> BakePlan:
     """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
     with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
-    and the occluders occlude, the target does not)."""
-    return drain(make_plan_steps(target, occluders, settings, high_to_low))
+    and the occluders occlude, the target does not), its rays cast by `cast` (default the
+    CPU's, projection.project_steps)."""
+    return drain(make_plan_steps(target, occluders, settings, high_to_low, cast))
 
 
 def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-                    high_to_low: HighToLow | None = None) -> Generator[float, None, BakePlan]:
+                    high_to_low: HighToLow | None = None, cast: RayCast | None = None
+                    ) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled."""
     settings = settings.validated()
@@ -214,7 +216,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     extent = 1.0  # radius of the receivers' sphere about the origin, normalized
     if high_to_low is not None:
         projected, projection_stats, warning = yield from projected_receivers_steps(
-            target, high_to_low, settings, centre, scale)
+            target, high_to_low, settings, centre, scale, cast)
         uv_warnings = uv_warnings + ([warning] if warning else [])
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))

@@ -10,10 +10,11 @@ As Blender's bake does it (render/intern/bake.cc, RE_bake_pixels_populate_from_o
   same barycentric coordinates and points towards the low-poly point;
 - the nearest hit of any source, front or back face, wins; with a max ray distance > 0 a
   hit farther than that from the ray's start is a miss. A sample that misses gets no value.
-One ray per sample, once per bake (mathutils' BVH, about 2 us a ray here; the GPU passes
-then bake the hit points like any other receivers), in steps of RAYS_PER_STEP rays: the
-*_steps generators yield the fraction cast after each, so a modal bake can draw progress and
-be cancelled during a projection of seconds.
+One ray per sample, once per bake (here with mathutils' BVH, about 2.5 us a ray; the GPU
+bakers cast with its twin gpu/bake_ray_cast.py, bakers.ray_caster_for; the passes then bake
+the hit points like any other receivers), in steps of RAYS_PER_STEP rays: the *_steps
+generators yield the fraction cast after each, so a modal bake can draw progress and be
+cancelled during a projection of seconds.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ import time
 from itertools import repeat
 from operator import itemgetter
 from dataclasses import dataclass
-from typing import Generator
+from typing import Callable, Generator
 
 import numpy as np
 
@@ -157,29 +158,41 @@ def barycentric(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     safe = np.where(np.abs(det) > 0.0, det, 1.0)
     v = (d22 * p1 - d12 * p2) / safe
     w = (d11 * p2 - d12 * p1) / safe
-    out = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
+    return barycentric_from_uv(np.stack([v, w], axis=1))
+
+
+def barycentric_from_uv(uv: np.ndarray) -> np.ndarray:
+    """(m, 3) barycentric coordinates (1 - u - v, u, v) of uv (m, 2), clipped to the triangle
+    and renormalized (a float32 hit can lie a hair outside its edges)."""
+    out = np.clip(np.stack([1.0 - uv[:, 0] - uv[:, 1], uv[:, 0], uv[:, 1]], axis=1), 0.0, 1.0)
     return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-30)
 
 
+# A ray cast: project_steps' signature (origins, directions, triangles, max ray distance),
+# a generator of progress fractions that returns (face, bary). bakers.ray_caster_for() gives
+# the GPU twin (gpu/bake_ray_cast.py) to the GPU bakers.
+RayCast = Callable[[np.ndarray, np.ndarray, np.ndarray, float], Generator[float, None, tuple[np.ndarray, np.ndarray]]]
+
+
 def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, centre: np.ndarray,
-                        scale: float) -> tuple[Receivers, dict, str | None]:
+                        scale: float, cast: RayCast | None = None) -> tuple[Receivers, dict, str | None]:
     """projected_receivers_steps() run to its end."""
-    return drain(projected_receivers_steps(target, request, settings, centre, scale))
+    return drain(projected_receivers_steps(target, request, settings, centre, scale, cast))
 
 
 def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,
-                              centre: np.ndarray, scale: float
+                              centre: np.ndarray, scale: float, cast: RayCast | None = None
                               ) -> Generator[float, None, tuple[Receivers, dict, str | None]]:
     """The receivers of a Selected-to-Active bake: the source points the target's texel
-    samples project to, with the sources' own shading normals (settings.normals), weight
-    scale 1 (each is normalized by its own weight sum: estimators.texel_sums), positions
-    normalized by (centre (3,), scale). Returns them, stats, and a warning when many texels
-    found nothing."""
+    samples project to (rays cast by `cast`, default project_steps), with the sources' own
+    shading normals (settings.normals), weight scale 1 (each is normalized by its own weight
+    sum: estimators.texel_sums), positions normalized by (centre (3,), scale). Returns them,
+    stats, and a warning when many texels found nothing."""
     texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
     origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
     triangles = np.concatenate([s.positions for s in request.sources])
     started = time.perf_counter()
-    hit_face, hit_bary = yield from project_steps(origins, rays, triangles, settings.max_ray_distance)
+    hit_face, hit_bary = yield from (cast or project_steps)(origins, rays, triangles, settings.max_ray_distance)
     seconds = time.perf_counter() - started
     hit = hit_face >= 0
     hf, hb = hit_face[hit], hit_bary[hit]
