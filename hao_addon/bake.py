@@ -21,8 +21,9 @@ from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
-from .core.bake.seams import finalize_map, finalize_vectors
+from .core.bake.seams import element_values, finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
+from .core.bake.vertex_target import VertexTarget
 
 
 @dataclass
@@ -30,13 +31,17 @@ class BakeResult:
     """ao: (size, size) float32 accessibility (1 = open), row 0 at v = 0 (Blender's pixel
     order); covered: texels with a direct estimate; filled: covered plus margin;
     bent_normals: (size, size, 3) float32 unit world-space bent normals (zero outside
-    filled), or None unless settings.bent_normals."""
+    filled), or None unless settings.bent_normals. A colour-attribute bake (VertexTarget):
+    ao, covered and filled are (count,), one per vertex or corner (1.0 where no lit corner
+    sampled it, e.g. a loose vertex). A UDIM layout: tiles are the UDIM numbers, and ao,
+    covered, filled (and bent_normals) gain a leading axis, one map per tile in that order."""
 
     ao: np.ndarray
     covered: np.ndarray
     filled: np.ndarray
     stats: dict = field(default_factory=dict)
     bent_normals: np.ndarray | None = None
+    tiles: tuple[int, ...] | None = None
 
 
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
@@ -48,9 +53,12 @@ _CACHE_SIZE = 8
 
 
 def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-            high_to_low: HighToLow | None) -> str:
+            high_to_low: HighToLow | None, vertex_target: VertexTarget | None) -> str:
     h = hashlib.blake2b(digest_size=20)
     h.update(repr(settings.cache_key()).encode())
+    if vertex_target is not None:
+        h.update(b"|vertex-target|%d|" % vertex_target.count)
+        h.update(np.ascontiguousarray(vertex_target.cells).tobytes())
     sources = []
     if high_to_low is not None:
         sources = high_to_low.sources
@@ -71,21 +79,23 @@ def clear_cache() -> None:
 
 
 def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-               use_cache: bool = True, high_to_low: HighToLow | None = None) -> Generator[float, None, BakeResult]:
+               use_cache: bool = True, high_to_low: HighToLow | None = None,
+               vertex_target: VertexTarget | None = None) -> Generator[float, None, BakeResult]:
     """Bake `target` (with UVs) against itself and `occluders`; yields progress in [0, 1].
-    With `high_to_low`, bake its sources onto the target's UVs (Selected to Active).
+    With `high_to_low`, bake its sources onto the target's UVs (Selected to Active); with
+    settings.target 'color-attribute', at the face corners of `vertex_target` (no UVs).
 
     A re-bake of identical geometry, UVs and settings returns the cached result at once
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
     """
     t0 = time.perf_counter()
-    key = _digest(target, occluders, settings, high_to_low) if use_cache else None
+    key = _digest(target, occluders, settings, high_to_low, vertex_target) if use_cache else None
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
         yield 1.0
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True},
-                          cached.bent_normals)
+                          cached.bent_normals, cached.tiles)
 
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     method = settings.method_for(high_to_low is not None)
@@ -93,7 +103,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
     # The method's own ray cast (an unknown method is refused by the plan's validation).
     cast = ray_caster_for(method) if high_to_low is not None and method in BAKE_METHODS else None
     cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
-    planning = make_plan_steps(target, occluders, settings, high_to_low, cast)
+    planning = make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target)
     try:
         while True:
             try:
@@ -104,6 +114,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
             yield share * fraction
     finally:
         planning.close()  # cancelled during the projection: stop it there
+    method = settings.method_for(high_to_low is not None, tiled=plan.udim is not None)
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
@@ -116,14 +127,25 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         gpu_stats = dict(baker.stats)
     finally:
         baker.free()
-    # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py).
-    ao, covered, filled = finalize_map(*plan.estimator.ratio(sums), settings.margin)
+    # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py), or
+    # the colour attribute's values, one per element.
     bent = None
-    if plan.estimator is BENT_NORMALS:
-        bent = finalize_vectors(BENT_NORMALS.bent(sums), covered, filled, settings.margin)
+    if plan.vertex_target is not None:
+        ao, covered, filled = element_values(*plan.estimator.ratio(sums))
+    else:  # one map, or one per UDIM tile, each with its own margins
+        tiles = sums if plan.udim is not None else sums[None]
+        maps = [finalize_map(*plan.estimator.ratio(tile), settings.margin) for tile in tiles]
+        ao, covered, filled = (np.stack(part) for part in zip(*maps))
+        if plan.estimator is BENT_NORMALS:
+            bent = np.stack([finalize_vectors(BENT_NORMALS.bent(tile), c, f, settings.margin)
+                             for tile, c, f in zip(tiles, covered, filled)])
+        if plan.udim is None:
+            ao, covered, filled = ao[0], covered[0], filled[0]
+            bent = None if bent is None else bent[0]
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "seconds": time.perf_counter() - t0, "cache_hit": False}
-    result = BakeResult(ao, covered, filled, stats, bent)
+    tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
+    result = BakeResult(ao, covered, filled, stats, bent, tile_numbers)
     if key is not None:
         _CACHE[key] = result
         while len(_CACHE) > _CACHE_SIZE:
@@ -133,9 +155,9 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
 
 def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
          progress: Callable[[float], None] | None = None, use_cache: bool = True,
-         high_to_low: HighToLow | None = None) -> BakeResult:
+         high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> BakeResult:
     """Blocking bake (drains bake_steps)."""
-    steps = bake_steps(target, occluders, settings, use_cache, high_to_low)
+    steps = bake_steps(target, occluders, settings, use_cache, high_to_low, vertex_target)
     try:
         while True:
             try:
@@ -148,4 +170,4 @@ def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSett
         steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
 
 
-__all__ = ["BakeInputError", "BakeResult", "HighToLow", "bake", "bake_steps", "clear_cache"]
+__all__ = ["BakeInputError", "BakeResult", "HighToLow", "VertexTarget", "bake", "bake_steps", "clear_cache"]

@@ -51,7 +51,9 @@ def build_parser() -> argparse.ArgumentParser:
     b = sub.add_parser("bake", help="bake per-texel AO of a mesh into an image file")
     b.add_argument("input", help=".obj, .glb/.gltf or .blend file")
     b.add_argument("--out", required=True, help="output .png (16-bit) or .exr (32-bit float); "
-                                                "{object} becomes the baked object's name")
+                                                "{object} becomes the baked object's name. With --target "
+                                                "color-attribute: the mesh file to save, .blend (the whole "
+                                                "scene), .glb (COLOR_0) or .ply (vertex colours)")
     add_setting_options(b, BakeSettings)
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
     b.add_argument("--object", default="", help="mesh to bake (default: the mesh with the most faces)")
@@ -213,36 +215,59 @@ def _mesh_names() -> str:
     return ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
 
 
-def check_gltf_target(path: str, source: Path) -> Path:
-    """The --gltf-out file, refused before any work unless it is a .glb in a writable folder
-    and not the input."""
+# The files a colour-attribute bake saves its mesh to (--target color-attribute --out FILE).
+MESH_OUT_FORMATS = (".blend", ".glb", ".ply")
+
+
+def check_mesh_target(path: str, source: Path, allowed: tuple[str, ...], option: str) -> Path:
+    """A mesh file to write (--gltf-out, or --out of a colour-attribute bake), refused before
+    any work unless its extension is allowed, its folder writable and it is not the input."""
     out = Path(os.path.abspath(path))
-    if out.suffix.lower() != ".glb":
-        raise CLIError(f"--gltf-out must be a .glb file (one file, written atomically), got '{path}'")
+    if out.suffix.lower() not in allowed:
+        raise CLIError(f"{option} must be a {' or '.join(allowed)} file (one file, written atomically), got '{path}'")
     if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
         raise CLIError(f"cannot write '{out}': its folder does not exist or is not writable")
     if out.exists() and out.resolve() == source.resolve():
-        raise CLIError(f"--gltf-out '{out}' is the input file")
+        raise CLIError(f"{option} '{out}' is the input file")
     return out
 
 
-def export_glb(obj, path: Path) -> None:
-    """Write obj alone as a .glb with Blender's glTF exporter, atomically (a temporary file in
-    the same folder, renamed over path)."""
+def check_gltf_target(path: str, source: Path) -> Path:
+    """The --gltf-out file: a .glb (check_mesh_target)."""
+    return check_mesh_target(path, source, (".glb",), "--gltf-out")
+
+
+def export_mesh_file(obj, path: Path, colors: bool = False) -> None:
+    """Write obj alone as a .glb (Blender's glTF exporter; colors: with its active colour
+    attribute as COLOR_0) or a .ply (linear vertex colours when colors), or the whole session
+    as a .blend copy; atomically (a temporary file in the same folder, renamed over path)."""
     import bpy
 
     for other in bpy.context.view_layer.objects:
         other.select_set(other == obj)
     bpy.context.view_layer.objects.active = obj
-    tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}.glb")
+    suffix = path.suffix.lower()
+    tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}{suffix}")
     try:
-        result = bpy.ops.export_scene.gltf(filepath=str(tmp), export_format='GLB', use_selection=True)
+        if suffix == ".glb":
+            extra = {"export_vertex_color": 'ACTIVE'} if colors else {}
+            result = bpy.ops.export_scene.gltf(filepath=str(tmp), export_format='GLB', use_selection=True, **extra)
+        elif suffix == ".ply":
+            result = bpy.ops.wm.ply_export(filepath=str(tmp), export_selected_objects=True,
+                                           export_colors='LINEAR' if colors else 'NONE')
+        else:
+            result = bpy.ops.wm.save_as_mainfile(filepath=str(tmp), copy=True, check_existing=False)
         if result != {'FINISHED'} or not tmp.is_file():
-            raise CLIError(f"the glTF export of '{obj.name}' failed")
+            raise CLIError(f"writing '{obj.name}' to {path.name} failed")
         os.replace(tmp, path)
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def export_glb(obj, path: Path) -> None:
+    """Write obj alone as a .glb with its baked map (export_mesh_file)."""
+    export_mesh_file(obj, path)
 
 
 def pick_target(name: str, exclude: tuple = ()):
@@ -267,6 +292,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     import bpy
 
     from .blender.bake_job import BakeJob, BakeRequest, output_path_for
+    from .blender.color_attributes import AO_ATTRIBUTE
     from .blender.paths import OBJECT_TOKEN
     from .core.imageio import check_writable
     from .core.bake.settings import BakeSettings
@@ -275,6 +301,10 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     source = check_input(Path(args.input), INPUT_FORMATS)
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
+    to_colors = settings.target == "color-attribute"
+    if to_colors and (args.bent_normal_out or args.gltf_out):
+        raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out "
+                       "(.blend, .glb or .ply); --bent-normal-out and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
         check_writable(args.bent_normal_out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 4,
@@ -283,7 +313,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     report.input = str(source)
     # Refused before a long load; checked again with the object's name once it is known.
-    check_writable(args.out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 1, source=source)
+    mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
+    if not to_colors:
+        check_writable(args.out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 1, source=source)
     check_json_target(args.json)
     with report.phase("load"):
         progress.update("loading")
@@ -300,7 +332,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     request = BakeRequest(targets=[target], settings=settings,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
-                          filepath=str(Path(os.path.abspath(args.out))), source_path=str(source),
+                          filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
+                          source_path=str(source),
                           high_poly=high_poly, cage=cage,
                           bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
                           bent_space=args.bent_space, bent_convention=args.bent_convention,
@@ -315,6 +348,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         check_signals()  # never commit a run that was asked to stop
         with report.phase("write"):
             job.commit()
+            if mesh_out is not None:
+                export_mesh_file(target, mesh_out, colors=True)
             if gltf_out is not None:
                 try:
                     export_glb(target, gltf_out)
@@ -330,7 +365,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     lines = []
     for obj, uv_name, result in job.results:
         st = result.stats
-        out = output_path_for(request, obj)
+        out = str(mesh_out) if to_colors else output_path_for(request, obj)
         report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
                                    uv_map_created=any(n == uv_name for _m, n in job.created_uv),
                                    covered_texels=st["covered_texels"], method=st["method"],
@@ -343,9 +378,10 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         if gltf_out is not None:
             report.outputs.append(str(gltf_out))
         report.warnings.extend(st.get("warnings", []))
-        lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, UV map '{uv_name}') "
-                     f"{settings.size}x{settings.size}, {settings.directions} directions in "
-                     f"{time.perf_counter() - t0:.2f} s -> {out}")
+        where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
+                 f"'{AO_ATTRIBUTE}')" if to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
+        lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, {where}, {settings.directions} "
+                     f"directions in {time.perf_counter() - t0:.2f} s -> {out}")
     return lines
 
 

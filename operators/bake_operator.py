@@ -8,6 +8,7 @@ import time
 import bpy
 
 from ..hao_addon.blender.bake_job import BakeJob
+from ..hao_addon.blender.color_attributes import AO_ATTRIBUTE
 from ..hao_addon.core.errors import BakeInputError
 from ..hao_addon.gpu.context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
@@ -95,6 +96,10 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         for _obj, _uv, result in job.results:
             for warning in result.stats.get("warnings", []):
                 self.report({'WARNING'}, warning)
+        if job.request.to_color_attribute:
+            names = ", ".join(f"'{obj.name}'" for obj, _uv, _result in job.results)
+            self.report({'INFO'}, f"Baked AO into the colour attribute '{AO_ATTRIBUTE}' of {names}")
+            return
         names = ", ".join(f"'{im.name}'" for im in job.committed)
         self.report({'INFO'}, f"Baked AO into {names}")
 

@@ -49,6 +49,11 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         extrusion.prop(settings, "cage_extrusion")
         sub.prop(settings, "max_ray_distance")
         col.separator()
+        col.prop(settings, "target")
+        if settings.target == "color-attribute":
+            col.prop(settings, "color_domain")
+        outer, col = col, col.column()
+        col.active = settings.target == "image"  # the image outputs
         col.prop(settings, "uv_mode")
         if settings.uv_mode == 'NAMED':
             obj = context.active_object
@@ -66,7 +71,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.prop(settings, "bent_space")
         sub.prop(settings, "bent_convention")
         sub.prop(settings, "bent_filepath")
-        col.prop(settings, "view_samples")
+        outer.prop(settings, "view_samples")
         layout.separator()
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
 

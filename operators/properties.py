@@ -71,8 +71,11 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
             cage = self.cage_object
             high_poly = [o for o in targets if o != active and o != cage]
             targets = [active] if active is not None else []
-        return BakeRequest(targets=targets, settings=self.to_settings(), occluders=self.occluders, uv_map=uv,
-                           image=self.image, filepath=self.filepath, wire_material=self.wire_material,
+        settings = self.to_settings()
+        to_image = settings.target == "image"  # a colour attribute ignores the image outputs
+        return BakeRequest(targets=targets, settings=settings, occluders=self.occluders, uv_map=uv,
+                           image=self.image if to_image else None, filepath=self.filepath if to_image else "",
+                           wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
                            bent_space=self.bent_space, bent_convention=self.bent_convention)

@@ -177,6 +177,15 @@ CASES = [
     ("output-is-folder-png", [BAKE, "{in}/spot.obj", "--out", "{in}/dir.png"], 2, "it is a folder"),
     ("report-folder-missing", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/no/r.json"], 2,
      "cannot write the report"),
+    # the colour-attribute target: --out is the mesh file to save
+    ("color-attribute-image-out", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--target", "color-attribute"], 2,
+     "--out must be a .blend or .glb or .ply file"),
+    ("color-attribute-out-is-input", [BAKE, "{in}/scene.blend", "--out", "{in}/scene.blend", "--target",
+                                      "color-attribute"], 2, "is the input file"),
+    ("color-attribute-with-gltf-out", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target", "color-attribute",
+                                       "--gltf-out", "{out}/b.glb"], 2, "are image bakes"),
+    ("unknown-color-domain", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target", "color-attribute",
+                              "--color-domain", "face"], 2, "invalid choice"),
     # render-ao
     ("render-missing-input", [RENDER, "{in}/missing.blend", "--out", "{out}/a.png"], 2, "input file not found"),
     ("render-no-camera", [RENDER, "{in}/nocamera.blend", "--out", "{out}/a.png"], 2, "no camera"),

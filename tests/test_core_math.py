@@ -424,9 +424,9 @@ def test_texel_sums_normalize_each_receiver_by_its_own_weight_sum():
 
     texel = np.array([0, 0, 1, 1])
     sums = np.array([[2.0, 10.0], [800.0, 1000.0], [3.0, 6.0], [0.0, 0.0]])
-    out = texel_sums(texel, sums, 2)
+    out = texel_sums(texel, sums, (2, 2))
     numerator, weight = AMBIENT_OCCLUSION.ratio(out)
     np.testing.assert_allclose(numerator.ravel(), [1.0, 0.5, 0.0, 0.0])
     np.testing.assert_allclose(weight.ravel(), [2.0, 1.0, 0.0, 0.0])
-    scaled = texel_sums(texel, sums * np.array([7.0, 0.01, 3.0, 5.0])[:, None], 2)
+    scaled = texel_sums(texel, sums * np.array([7.0, 0.01, 3.0, 5.0])[:, None], (2, 2))
     np.testing.assert_allclose(scaled, out)

@@ -19,6 +19,7 @@ def test_core_api_snippet_runs_as_written(gpu_context, monkeypatch):
     exec(compile(block.group(1), "README.md", "exec"), namespace)  # noqa: S102 - our own README
     result = namespace["result"]
     assert result.ao.shape == (1024, 1024) and result.ao.dtype == np.float32 and "covered_texels" in result.stats
+    assert namespace["per_vertex"].ao.shape == (len(namespace["v"]),)
     again = namespace["bake"](namespace["target"], namespace["occluders"], namespace["BakeSettings"](size=1024))
     assert again.stats["cache_hit"] and again.ao is result.ao  # "an identical call returns the cached result"
 

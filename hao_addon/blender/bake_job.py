@@ -24,7 +24,7 @@ from ..core.bake.settings import BakeSettings
 from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
-from . import images, mesh_data
+from . import color_attributes, images, mesh_data
 from .paths import OBJECT_TOKEN, absolute_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
@@ -45,7 +45,9 @@ class BakeRequest:
     target's topology, moved vertices) the rays start from.
     Bent normals (settings.bent_normals): each target also gets an image '<object>_BentNormals'
     in bent_space ('tangent': the baked UV map's MikkTSpace; 'object') and bent_convention
-    ('opengl' Y+, 'directx' Y-), saved to bent_filepath if given (tokens as filepath)."""
+    ('opengl' Y+, 'directx' Y-), saved to bent_filepath if given (tokens as filepath).
+    settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
+    instead (settings.color_domain), UV map, image and files unused."""
 
     targets: list
     settings: BakeSettings
@@ -61,6 +63,12 @@ class BakeRequest:
     bent_filepath: str = ""
     bent_space: str = "tangent"
     bent_convention: str = "opengl"
+
+    @property
+    def to_color_attribute(self) -> bool:
+        """settings.target 'color-attribute': AO into each target's colour attribute hao_ao
+        (blender/color_attributes.py), no UV map, image or file."""
+        return self.settings.target == "color-attribute"
 
 
 def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeSettings:
@@ -97,11 +105,15 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError("a cage object is used only with Selected to Active")
     if not request.targets:
         raise BakeInputError("no mesh selected: select one or more mesh objects to bake")
+    if request.to_color_attribute:
+        _validate_color_attribute(request)
     for obj in request.targets:
         if obj.type != 'MESH':
             raise BakeInputError(f"'{obj.name}' is not a mesh")
         if len(obj.data.polygons) == 0:
             raise BakeInputError(f"'{obj.name}' has no faces to bake")
+        if request.to_color_attribute:
+            continue
         name = request.uv_map
         if name not in ("", "AUTO") and name not in obj.data.uv_layers:
             raise BakeInputError(f"'{obj.name}' has no UV map named '{name}'")
@@ -129,6 +141,15 @@ def validate_request(request: BakeRequest) -> None:
                                      f"'{path}'")
             writers[path] = obj.name
             check_writable(path, size, size, channels, source=request.source_path or None)
+
+
+def _validate_color_attribute(request: BakeRequest) -> None:
+    if request.high_poly is not None or request.settings.bent_normals:
+        raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active and "
+                             "bent normals bake into images (Target: Image Textures)")
+    if request.filepath or request.image is not None:
+        raise BakeInputError("a colour-attribute bake writes no image: clear the image and the file path, or "
+                             "bake to Image Textures")
 
 
 def _validate_high_to_low(request: BakeRequest) -> None:
@@ -232,19 +253,22 @@ class BakeJob:
         """Yield (fraction done, status text) after each light direction."""
         req = self.request
         uv_names = {}
-        for obj in req.targets:
-            uv_names[obj.name] = yield from self._uv_name_for(obj)
+        for obj in req.targets:  # a colour attribute needs no UV map
+            uv_names[obj.name] = "" if req.to_color_attribute else (yield from self._uv_name_for(obj))
         depsgraph = self._depsgraph_getter()
         n = len(req.targets)
         for k, obj in enumerate(req.targets):
-            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name],
+            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name] or None,
                                               shading_normals=req.settings.normals == "mesh")
+            vertex_target = None
+            if req.to_color_attribute:
+                vertex_target = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
             high_to_low = self._high_to_low(obj, depsgraph) if req.high_poly is not None else None
             skip = set(req.high_poly or ()) | {req.cage}
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
                          for o in self._occluder_objects(obj) if o not in skip]
             settings = terminator_settings(req.settings, req.high_poly or [obj])
-            gen = bake_steps(target, occluders, settings, high_to_low=high_to_low)
+            gen = bake_steps(target, occluders, settings, high_to_low=high_to_low, vertex_target=vertex_target)
             try:
                 while True:
                     try:
@@ -281,10 +305,15 @@ class BakeJob:
 
     # -- ending ----------------------------------------------------------------------------
     def commit(self) -> list:
-        """Write files (atomically), then images and material nodes. Returns the images."""
+        """Write files (atomically), then images and material nodes (or the colour
+        attributes). Returns the images."""
         if not self.finished:
             raise RuntimeError("commit() before the bake finished")
         req = self.request
+        if req.to_color_attribute:
+            for obj, _uv, result in self.results:
+                color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
+            return self.committed
         for obj, _uv, result in self.results:
             path = output_path_for(req, obj)
             if path:

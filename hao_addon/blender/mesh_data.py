@@ -6,6 +6,7 @@ import bpy
 import numpy as np
 
 from ..core.errors import BakeInputError
+from ..core.bake.vertex_target import VertexTarget, vertex_target
 from ..core.geometry import TriangleSoup
 
 AO_UV_NAME = "AO_UV"
@@ -131,6 +132,30 @@ def extrusion_normals(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> 
         flat = ~smooth[tri_face]
         normals[flat] = face_n.reshape(-1, 3).astype(np.float64)[tri_face[flat]][:, None, :]
         return normals, linear
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def color_attribute_target(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, domain: str) -> VertexTarget:
+    """The colour-attribute target of the object's evaluated mesh, corners in evaluated_soup's
+    order, elements those of the original mesh (where the attribute is written). Raises
+    BakeInputError where modifiers change the topology: Cycles maps such corners back
+    through original indices the Python API does not expose."""
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        _co, _tri_verts, tri_loops = _mesh_arrays(mesh)
+        if (len(mesh.vertices), len(mesh.loops)) != (len(obj.data.vertices), len(obj.data.loops)):
+            raise BakeInputError(f"'{obj.name}': its modifiers change the mesh's vertices or corners, so the baked "
+                                 f"values have no vertex of the mesh to go to; apply them, or bake an image")
+        if np.linalg.det(np.array(obj_eval.matrix_world, dtype=np.float64)[:3, :3]) < 0.0:
+            tri_loops = tri_loops[:, ::-1]
+        loop_vertex = np.empty(len(mesh.loops), np.int64)
+        mesh.loops.foreach_get("vertex_index", loop_vertex)
+        target = vertex_target(tri_loops, loop_vertex, domain)
+        if domain == "point":
+            target.count = len(mesh.vertices)  # loose vertices too (they keep the unoccluded 1.0)
+        return target
     finally:
         obj_eval.to_mesh_clear()
 

@@ -143,7 +143,8 @@ GPU_TEXEL_LIST = True
 
 def cpu_receivers(plan: BakePlan) -> Receivers | None:
     """The receivers the gather uploads, or None where its GPU raster lists them."""
-    if plan.projected is None and plan.settings.sample_count == 1 and GPU_TEXEL_LIST:
+    if (plan.projected is None and plan.vertex_target is None and plan.udim is None and plan.settings.sample_count == 1
+            and GPU_TEXEL_LIST):
         return None
     return plan.receivers()
 
@@ -518,7 +519,8 @@ class GatherBaker(LightViewBaker):
         self.stats["texel_tests_skipped"] += (self.entry_count - tested) * len(views)
 
     def accumulated(self) -> np.ndarray:
-        """(size, size, channels) float64: the estimator's sums, the entries summed per texel."""
+        """(*plan.output_shape, channels) float64: the estimator's sums, the entries summed per
+        texel (or colour-attribute element)."""
         self._test_pending_views()  # directions of a bake stopped short of its last one
         if self.layered:  # pixels whose depth list overflowed, counted over the whole bake
             self.stats["layer_overflow_pixels"] = int(util.texture_to_numpy(self.overflow, np.uint32).ravel()[0])
@@ -526,7 +528,7 @@ class GatherBaker(LightViewBaker):
         n = self.entry_count
         channels = self.plan.estimator.channel_count
         if n == 0:
-            return np.zeros((size, size, channels))
+            return np.zeros((*self.plan.output_shape, channels))
         parts = [util.texture_to_numpy(accum, np.float32).reshape(-1, FORMAT_CHANNELS[fmt])[:n]
                  for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels])]
         sums = np.concatenate(parts, axis=1).astype(np.float64)
@@ -535,4 +537,4 @@ class GatherBaker(LightViewBaker):
         else:
             texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
             flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
-        return texel_sums(flat, sums, size)
+        return texel_sums(flat, sums, self.plan.output_shape)

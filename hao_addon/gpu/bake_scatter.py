@@ -87,6 +87,12 @@ class ScatterBaker(LightViewBaker):
         if plan.projected is not None:
             raise BakeInputError("the histogram scatter cannot bake Selected to Active (it draws the target's own "
                                  "surface); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
+        if plan.udim is not None:
+            raise BakeInputError("the histogram scatter bakes one UV tile, not UDIM tiles; use the gather "
+                                 "(Shadow-Map Gather, also Auto's choice) or the reference")
+        if plan.vertex_target is not None:
+            raise BakeInputError("the histogram scatter cannot bake a colour attribute (it rasterizes the UV "
+                                 "layout); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
         # Its accumulator packs (numerator, denominator) with numerator <= denominator in one
         # word (gpu_shaders/bake_common.glsl): the ambient-occlusion estimator's sums only.
         if plan.estimator is not AMBIENT_OCCLUSION:

@@ -92,9 +92,10 @@ AMBIENT_OCCLUSION = AmbientOcclusion()
 BENT_NORMALS = BentNormals()
 
 
-def texel_sums(texel: np.ndarray, sums: np.ndarray, size: int) -> np.ndarray:
-    """(size, size, C) float64: receivers' sums (n, C) added up per flat texel index (n,),
-    each receiver's first divided by its own weight sum W (the last channel).
+def texel_sums(texel: np.ndarray, sums: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """(*shape, C) float64: receivers' sums (n, C) added up per flat output index (n,) (a
+    texel y * size + x of a (size, size) map, or a colour attribute's element), each
+    receiver's first divided by its own weight sum W (the last channel).
 
     That division is the exact normalization per receiver: every receiver that some direction
     lights weighs 1 in its texel, whatever the discrete hemisphere weight sum S of its shading
@@ -103,5 +104,6 @@ def texel_sums(texel: np.ndarray, sums: np.ndarray, size: int) -> np.ndarray:
     (W = 0) adds nothing."""
     weight = sums[:, -1:]
     normalized = np.divide(sums, weight, out=np.zeros_like(sums), where=weight > 0.0)
-    return np.stack([np.bincount(texel, weights=normalized[:, c], minlength=size * size)
-                     for c in range(sums.shape[1])], axis=-1).reshape(size, size, sums.shape[1])
+    cells = int(np.prod(shape))
+    return np.stack([np.bincount(texel, weights=normalized[:, c], minlength=cells)
+                     for c in range(sums.shape[1])], axis=-1).reshape(*shape, sums.shape[1])

@@ -19,9 +19,11 @@ from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_sha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
-from .receivers import Receivers, uv_receivers
+from .receivers import Receivers, corner_receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
+from .udim import UdimLayout, udim_layout
+from .vertex_target import VertexTarget
 from .views import OrthoView, cell_corners, fit_views
 
 # The light view never exceeds this many pixels per side (GPU limit is checked separately);
@@ -76,15 +78,34 @@ class BakePlan:
     # Selected to Active: the high-poly points the target's texels project to
     # (core/bake/projection.py); the target itself is then neither a receiver nor drawn.
     projected: Receivers | None = None
+    # The colour-attribute target (core/bake/vertex_target.py): receivers at the target's
+    # face corners, summed per vertex or corner instead of per texel.
+    vertex_target: VertexTarget | None = None
+    # The UDIM tiles of a tiled UV layout (core/bake/udim.py): one map per tile.
+    udim: UdimLayout | None = None
     stats: dict = field(default_factory=dict)
 
     def receivers(self) -> Receivers:
-        """The bake's receivers: the projected high-poly points, or the sample points of the
-        target's own UV layout (samples_per_texel of them per texel)."""
+        """The bake's receivers: the projected high-poly points, the target's face corners
+        (colour attributes), or the sample points of the target's own UV layout
+        (samples_per_texel of them per texel)."""
         if self.projected is not None:
             return self.projected
+        if self.vertex_target is not None:
+            return corner_receivers(self.target_faces, self.target_positions, self.target_corners,
+                                    self.vertex_target.cells, self.lifts_terminator)
         return uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
-                            self.settings.size, self.settings.sample_count, self.lifts_terminator)
+                            self.settings.size, self.settings.sample_count, self.lifts_terminator, self.udim)
+
+    @property
+    def output_shape(self) -> tuple[int, ...]:
+        """The shape of the bake's output elements: (size, size) texels, (tiles, size, size)
+        of a UDIM layout, or (count,) vertices or corners of a colour-attribute target."""
+        if self.vertex_target is not None:
+            return (self.vertex_target.count,)
+        if self.udim is not None:
+            return (self.udim.count, self.settings.size, self.settings.size)
+        return (self.settings.size, self.settings.size)
 
     @property
     def estimator(self) -> Estimator:
@@ -171,25 +192,40 @@ def _check_finite(soup: TriangleSoup) -> None:
 
 
 def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-              high_to_low: HighToLow | None = None, cast: RayCast | None = None) -> BakePlan:
+              high_to_low: HighToLow | None = None, cast: RayCast | None = None,
+              vertex_target: VertexTarget | None = None) -> BakePlan:
     """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
     with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
     and the occluders occlude, the target does not), its rays cast by `cast` (default the
-    CPU's, projection.project_steps)."""
-    return drain(make_plan_steps(target, occluders, settings, high_to_low, cast))
+    CPU's, projection.project_steps); or, with `vertex_target` (settings.target
+    'color-attribute'), at its face corners, UVs not needed."""
+    return drain(make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target))
+
+
+def _check_target(target: TriangleSoup, settings: BakeSettings, high_to_low: HighToLow | None,
+                  vertex_target: VertexTarget | None) -> None:
+    if target.face_count == 0:
+        raise BakeInputError(f"'{target.name}' has no faces to bake")
+    if settings.target == "color-attribute":
+        if vertex_target is None or vertex_target.cells.shape != (target.face_count, 3):
+            raise BakeInputError(f"'{target.name}': a colour-attribute bake needs the mesh's vertices and corners")
+        if high_to_low is not None or settings.bent_normals:
+            raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active and "
+                                 "bent normals bake into images (Target: Image Textures)")
+    elif target.uvs is None:
+        raise BakeInputError(f"'{target.name}' has no UV map")
+    _check_finite(target)
 
 
 def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-                    high_to_low: HighToLow | None = None, cast: RayCast | None = None
-                    ) -> Generator[float, None, BakePlan]:
+                    high_to_low: HighToLow | None = None, cast: RayCast | None = None,
+                    vertex_target: VertexTarget | None = None) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled."""
     settings = settings.validated()
-    if target.face_count == 0:
-        raise BakeInputError(f"'{target.name}' has no faces to bake")
-    if target.uvs is None:
-        raise BakeInputError(f"'{target.name}' has no UV map")
-    _check_finite(target)
+    _check_target(target, settings, high_to_low, vertex_target)
+    if settings.target != "color-attribute":
+        vertex_target = None
     for occ in occluders:
         _check_finite(occ)
     if high_to_low is not None:
@@ -199,10 +235,15 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     normals, areas = face_normals_areas(target.positions)
     if not (areas > 0.0).any():
         raise BakeInputError(f"'{target.name}' has only zero-area faces")
-    uv_area = uv_areas(target.uvs)
-    if not (uv_area > 0.0).any():
-        raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
-    uv_warnings, uv_counters = uv_layout_warnings(target.uvs, settings.size, target.name)
+    udim = None
+    if vertex_target is None:
+        uv_area = uv_areas(target.uvs)
+        if not (uv_area > 0.0).any():
+            raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
+        udim = udim_layout(target.uvs)
+        uv_warnings, uv_counters = _layout_warnings(target, settings.size, udim)
+    else:  # no UV layout: the light views are as fine as for a Size map over the bounding sphere
+        uv_area, uv_warnings, uv_counters = None, [], {}
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
@@ -216,7 +257,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     extent = 1.0  # radius of the receivers' sphere about the origin, normalized
     if high_to_low is not None:
         projected, projection_stats, warning = yield from projected_receivers_steps(
-            target, high_to_low, settings, centre, scale, cast)
+            target, high_to_low, settings, centre, scale, cast, udim)
         uv_warnings = uv_warnings + ([warning] if warning else [])
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))
@@ -249,27 +290,20 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
 
-    # Light-view pixel size from the texel density: world area per texel on each face.
-    size = settings.size
-    useful = (areas > 0.0) & (uv_area > 0.0)
-    texel_world_area = (areas[useful] / scale**2) / (uv_area[useful] * size * size)
-    order = np.argsort(texel_world_area)
-    cum = np.cumsum(areas[useful][order])
-    # The 10th area-percentile face density: 90 % of the surface gets at least
-    # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
-    density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
-    # The scatter's anti-aliasing: that many times more light-view pixels per texel.
-    scatter = settings.method_for(high_to_low is not None) == "scatter"
-    scatter_samples = settings.view_samples * (settings.sample_count if scatter else 1)
-    pixel_size = float(np.sqrt(density / scatter_samples))
+    if udim is not None and settings.method_for(high_to_low is not None, tiled=True) == "scatter":
+        raise BakeInputError(f"'{target.name}': the histogram scatter bakes one UV tile; its UVs lie on UDIM tiles "
+                             f"{', '.join(map(str, udim.tiles))}: use the gather (Shadow-Map Gather) or the reference")
+    if udim is not None:  # each tile as fine as its own bake would be: the finest of them
+        pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0]
+                         for faces in (np.flatnonzero(udim.face_tile == t) for t in range(udim.count)))
+        dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
+    elif vertex_target is None:
+        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale,
+                                                    settings.method_for(high_to_low is not None))
+    else:  # Size pixels across the bounding sphere's diameter (2), times sqrt(view samples)
+        pixel_size, dense_fraction = 2.0 / (settings.size * float(np.sqrt(settings.view_samples))), 0.0
     # The receivers' sphere has diameter 2 (the target's), or 2 extent in Selected to Active.
     pixel_size = max(pixel_size, 2.0 * extent / (MAX_VIEW_SIDE - 4))
-
-    # Fraction of the texels (UV area, not surface area: a small dense region can hold many
-    # texels) that are FOOTPRINT_SPLIT times smaller than a pixel per side.
-    texel_side = np.sqrt(texel_world_area)
-    uv_used = uv_area[useful]
-    dense_fraction = float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
     drawn_parts = [o_pos.reshape(-1, 3)] if projected is not None else [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)]
     drawn = np.concatenate(drawn_parts)
@@ -287,20 +321,70 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     if projected is not None:
         target_points = cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
 
+    if udim is not None:
+        uv_counters = {**uv_counters, "udim_tiles": [int(t) for t in udim.tiles]}
+    if vertex_target is not None:
+        uv_counters = {**uv_counters, "vertex_target_corners": int((vertex_target.cells >= 0).sum()),
+                       "vertex_target_elements": vertex_target.count}
     stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
-                 zero_uv_area_faces=int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
+                 zero_uv_area_faces=0 if uv_area is None else int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
                  occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
                  dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
                  holes=-1 if holes is None else len(holes), smooth_corners=smooth_corners,
                  samples_per_texel=settings.sample_count, warnings=uv_warnings, **uv_counters, **projection_stats)
-    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), target.uvs.astype(np.float32),
+    uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
+    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
                     o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, stats)
+                    closed, holes, projected, vertex_target, udim, stats)
+
+
+def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:
+    """uv_layout_warnings of the 0..1 tile, or of each UDIM tile (its triangles moved into
+    0..1; counters summed, the overlap fraction the largest)."""
+    if udim is None:
+        return uv_layout_warnings(target.uvs, size, target.name)
+    warnings, counters = [], {}
+    for tile, number in enumerate(udim.tiles):
+        _faces, local = udim.local_uvs(target.uvs, tile)
+        tile_warnings, tile_counters = uv_layout_warnings(local, size, f"{target.name}' tile '{number}")
+        warnings += tile_warnings
+        for key, value in tile_counters.items():
+            if isinstance(value, bool):
+                counters[key] = counters.get(key, True) and value
+            elif key.endswith("fraction"):
+                counters[key] = max(counters.get(key, 0.0), value)
+            else:
+                counters[key] = counters.get(key, 0) + value
+    return warnings, counters
+
+
+def _uv_pixel_size(settings: BakeSettings, areas: np.ndarray, uv_area: np.ndarray, scale: float,
+                   method: str) -> tuple[float, float]:
+    """(light-view pixel side, normalized; the fraction of the UV area whose texels are
+    FOOTPRINT_SPLIT times smaller than a pixel per side) from the texel density: the world
+    area per texel on each face. method: the bake variant that runs (the scatter samples
+    finer where it anti-aliases)."""
+    size = settings.size
+    useful = (areas > 0.0) & (uv_area > 0.0)
+    texel_world_area = (areas[useful] / scale**2) / (uv_area[useful] * size * size)
+    order = np.argsort(texel_world_area)
+    cum = np.cumsum(areas[useful][order])
+    # The 10th area-percentile face density: 90 % of the surface gets at least
+    # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
+    density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
+    # The scatter's anti-aliasing: that many times more light-view pixels per texel.
+    scatter = method == "scatter"
+    scatter_samples = settings.view_samples * (settings.sample_count if scatter else 1)
+    pixel_size = float(np.sqrt(density / scatter_samples))
+    # UV area, not surface area: a small dense region can hold many texels.
+    texel_side = np.sqrt(texel_world_area)
+    uv_used = uv_area[useful]
+    return pixel_size, float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
 
 def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,

@@ -28,7 +28,8 @@ import numpy as np
 
 from ..errors import BakeInputError
 from ..geometry import TriangleSoup, corner_shading_normals, face_normals_areas, smooth_vertex_normals
-from .receivers import Receivers, interpolate_unit, texel_sample_points
+from .receivers import Receivers, interpolate_unit, tiled_sample_points
+from .udim import UdimLayout
 from .settings import BakeSettings
 from .terminator import smooth_surface_lift
 
@@ -175,20 +176,22 @@ RayCast = Callable[[np.ndarray, np.ndarray, np.ndarray, float], Generator[float,
 
 
 def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, centre: np.ndarray,
-                        scale: float, cast: RayCast | None = None) -> tuple[Receivers, dict, str | None]:
+                        scale: float, cast: RayCast | None = None, tiles: UdimLayout | None = None
+                        ) -> tuple[Receivers, dict, str | None]:
     """projected_receivers_steps() run to its end."""
-    return drain(projected_receivers_steps(target, request, settings, centre, scale, cast))
+    return drain(projected_receivers_steps(target, request, settings, centre, scale, cast, tiles))
 
 
 def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,
-                              centre: np.ndarray, scale: float, cast: RayCast | None = None
+                              centre: np.ndarray, scale: float, cast: RayCast | None = None,
+                              tiles: UdimLayout | None = None
                               ) -> Generator[float, None, tuple[Receivers, dict, str | None]]:
     """The receivers of a Selected-to-Active bake: the source points the target's texel
     samples project to (rays cast by `cast`, default project_steps), with the sources' own
     shading normals (settings.normals), weight scale 1 (each is normalized by its own weight
     sum: estimators.texel_sums), positions normalized by (centre (3,), scale). Returns them,
     stats, and a warning when many texels found nothing."""
-    texel, face, bary = texel_sample_points(target.uvs, settings.size, settings.sample_count)
+    texel, face, bary = tiled_sample_points(target.uvs, settings.size, settings.sample_count, tiles)
     origins, rays = ray_starts(target, request, face, bary, settings.cage_extrusion)
     triangles = np.concatenate([s.positions for s in request.sources])
     started = time.perf_counter()
@@ -209,7 +212,7 @@ def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings
     if smooth and settings.terminator_offset > 0.0:  # Cycles lifts the high-poly's ray starts too
         lift = smooth_surface_lift(triangles[hf], corners[hf].astype(np.float64), hb, geometric) / scale
     receivers = Receivers(points, geometric, shading, np.ones(len(points)), texel[hit], lift)
-    cells = settings.size * settings.size
+    cells = settings.size * settings.size * (1 if tiles is None else tiles.count)
     sampled = int((np.bincount(texel, minlength=cells) > 0).sum())
     missed = sampled - int((np.bincount(receivers.texel, minlength=cells) > 0).sum())
     warning = None

@@ -5,7 +5,9 @@ A map's value at a texel is the ratio of its receivers' summed (V w, w) terms (c
 _shading_corners), so one bake design serves every kind of receiver:
 - the texel centres of the target's UV layout (what the gather's GPU texel list holds),
 - stratified sub-texel points of it (anti-aliasing, samples_per_texel > 1),
-- points on high-poly sources that the low-poly's texels project to (core/bake/projection.py).
+- points on high-poly sources that the low-poly's texels project to (core/bake/projection.py),
+- the target's face corners, each adding to its vertex or corner (core/bake/vertex_target.py).
+A UDIM layout's texel indices run over its tiles (core/bake/udim.py).
 The gather uploads a Receivers list as its texel list; the reference baker traces from it.
 """
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .terminator import smooth_surface_lift
+from .udim import UdimLayout
 from .uv_raster import texel_surface_samples
 
 
@@ -70,6 +73,20 @@ def texel_sample_points(uvs: np.ndarray, size: int, samples_per_texel: int = 1
     return texel.astype(np.int64), face[ys, xs], bary[ys, xs]
 
 
+def tiled_sample_points(uvs: np.ndarray, size: int, samples_per_texel: int = 1, tiles: UdimLayout | None = None
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """texel_sample_points() of every UDIM tile of a layout (tiles None: the 0..1 tile), each
+    tile's triangles moved into 0..1; texel indices are tile * size^2 + y * size + x."""
+    if tiles is None:
+        return texel_sample_points(uvs, size, samples_per_texel)
+    parts = []
+    for tile in range(tiles.count):
+        faces, local = tiles.local_uvs(uvs, tile)
+        texel, face, bary = texel_sample_points(local, size, samples_per_texel)
+        parts.append((texel + tile * size * size, faces[face], bary))
+    return tuple(np.concatenate(column) for column in zip(*parts))
+
+
 def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) -> np.ndarray:
     """(m, 3) unit vectors: corners (F, 3, 3) interpolated at (face (m,), bary (m, 3))."""
     v = np.einsum("mk,mkd->md", bary, corners[face].astype(np.float64))
@@ -77,12 +94,13 @@ def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) ->
 
 
 def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corners: np.ndarray, size: int,
-                 samples_per_texel: int = 1, lift: bool = False) -> Receivers:
+                 samples_per_texel: int = 1, lift: bool = False, tiles: UdimLayout | None = None) -> Receivers:
     """The target's own surface at the sample points of its UV layout (BakePlan fields:
     positions (F, 3, 3) normalized, uvs (F, 3, 2), faces (F, 4) normal and 1 / S_f, corners
     (F, 3, 4) shading normal and 1 / S). Faces never lit are left out. 1 / S is interpolated
-    like the GPU passes interpolate it. lift: with Cycles' terminator lift of each point."""
-    texel, face, bary = texel_sample_points(uvs, size, samples_per_texel)
+    like the GPU passes interpolate it. lift: with Cycles' terminator lift of each point.
+    tiles: the UDIM tiles of a tiled layout (texel tile * size^2 + y * size + x)."""
+    texel, face, bary = tiled_sample_points(uvs, size, samples_per_texel, tiles)
     lit = faces[face, 3] > 0.0
     texel, face, bary = texel[lit], face[lit], bary[lit]
     points = np.einsum("mk,mkd->md", bary, positions[face].astype(np.float64))
@@ -94,3 +112,24 @@ def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corn
         lifts = smooth_surface_lift(positions[face].astype(np.float64), corners[face, :, :3].astype(np.float64),
                                     bary, geometric)
     return Receivers(points, geometric, shading, inv_s, texel, lifts)
+
+
+def corner_receivers(faces: np.ndarray, positions: np.ndarray, corners: np.ndarray, cells: np.ndarray,
+                     lift: bool = False) -> Receivers:
+    """The target's face corners whose cell (F, 3) int64 is not -1, at their vertex with the
+    corner's own shading normal and 1 / S (BakePlan fields: faces (F, 4), positions (F, 3, 3)
+    normalized, corners (F, 3, 4)); `texel` is the cell. Faces never lit are left out. lift:
+    with Cycles' terminator lift (zero at a vertex, where the smooth surface meets the facet;
+    kept for the receivers' one layout)."""
+    keep = (cells >= 0) & (faces[:, 3] > 0.0)[:, None]
+    face, corner = np.nonzero(keep)
+    bary = np.eye(3)[corner]
+    geometric = faces[face, :3].astype(np.float64)
+    lifts = None
+    if lift:
+        lifts = smooth_surface_lift(positions[face].astype(np.float64), corners[face, :, :3].astype(np.float64),
+                                    bary, geometric)
+    shading = corners[face, corner, :3].astype(np.float64)
+    shading /= np.maximum(np.linalg.norm(shading, axis=1, keepdims=True), 1e-30)
+    return Receivers(positions[face, corner].astype(np.float64), geometric, shading,
+                     corners[face, corner, 3].astype(np.float64), cells[face, corner].astype(np.int64), lifts)

@@ -40,6 +40,8 @@ class ReferenceBaker:
         """Rays of a whole bake at most (one per receiver and direction)."""
         if plan.projected is not None:
             return len(plan.projected) * plan.settings.directions
+        if plan.vertex_target is not None:
+            return int((plan.vertex_target.cells >= 0).sum()) * plan.settings.directions
         return plan.settings.size ** 2 * plan.settings.sample_count * plan.settings.directions
 
     @classmethod
@@ -105,8 +107,8 @@ class ReferenceBaker:
         self.stats["directions_done"] += 1
 
     def accumulated(self) -> np.ndarray:
-        """(size, size, channels) float64: the estimator's sums per texel."""
-        return texel_sums(self.texel, self.sums, self.plan.settings.size)
+        """(*plan.output_shape, channels) float64: the estimator's sums per texel (or element)."""
+        return texel_sums(self.texel, self.sums, self.plan.output_shape)
 
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""

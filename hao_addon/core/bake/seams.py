@@ -84,6 +84,16 @@ def grow_mask(mask: np.ndarray, rings: int) -> np.ndarray:
     return out
 
 
+def element_values(numerator: np.ndarray, weight: np.ndarray, background: float = 1.0
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A colour attribute's values from its per-element sums (n,) (each lit corner weighs 1):
+    (ao (n,) float32 in [0, 1], covered (n,) bool: sampled by a lit corner, filled: the same;
+    unsampled elements hold `background`). No margins: elements have no neighbours to bleed."""
+    covered = weight > 0.0
+    ratio = np.divide(numerator, weight, out=np.full_like(numerator, background), where=covered)
+    return np.clip(ratio, 0.0, 1.0).astype(np.float32), covered, covered.copy()
+
+
 def finalize_map(numerator: np.ndarray, coverage: np.ndarray, margin: int,
                  background: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Accessibility map from the accumulated sums.

@@ -42,6 +42,15 @@ TERMINATOR_CHOICES = (
                                  "none (OBJ, glTF)"),
     Choice("setting", "Terminator Offset", "the Terminator Offset setting for every object"),
 )
+TARGET_CHOICES = (
+    Choice("image", "Image Textures", "an AO map in the UV layout"),
+    Choice("color-attribute", "Color Attribute", "AO per vertex (or face corner) into the mesh's colour attribute "
+                                                 "hao_ao, as Cycles' Color Attributes target bakes it; no UVs needed"),
+)
+COLOR_DOMAIN_CHOICES = (
+    Choice("point", "Vertex", "one value per vertex: the mean of its face corners (Cycles' point domain)"),
+    Choice("corner", "Face Corner", "one value per face corner, shaded with that corner's normal"),
+)
 SAMPLES_PER_TEXEL_CHOICES = (
     Choice("1", "Off", "one sample at each texel centre"),
     Choice("4", "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
@@ -102,6 +111,13 @@ class BakeSettings:
         False, label="Bent Normals", cli=None, cli_via="--bent-normal-out FILE",
         description="also bake the bent normal: each texel's cosine-weighted mean unoccluded direction, from "
                     "the same directions as the AO (gather and reference; the scatter cannot)")
+    target: str = setting(
+        "image", label="Target", noun="bake target", choices=TARGET_CHOICES,
+        description="where the AO goes; a colour attribute samples every vertex with light views as fine as a "
+                    "Size map's")
+    color_domain: str = setting(
+        "point", label="Domain", noun="colour-attribute domain", choices=COLOR_DOMAIN_CHOICES,
+        description="Color Attribute target: per vertex or per face corner")
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
@@ -119,13 +135,15 @@ class BakeSettings:
         distance (see method_for)."""
         return self.method_for(high_to_low=False)
 
-    def method_for(self, high_to_low: bool) -> str:
+    def method_for(self, high_to_low: bool, tiled: bool = False) -> str:
         """The bake variant that runs: 'auto' is the gather, except with a max distance on the
         target's own surface, where the scatter is (the benchmark's fastest at equal error);
-        Selected to Active and bent normals always gather (the scatter can bake neither)."""
+        Selected to Active, bent normals, colour attributes and UDIM tiles (tiled) always
+        gather (the scatter, which rasterizes one 0..1 UV layout, can bake none of them)."""
         if self.method != "auto":
             return self.method
-        return "scatter" if self.max_distance > 0.0 and not high_to_low and not self.bent_normals else "gather"
+        scatter_can = not high_to_low and not self.bent_normals and self.target == "image" and not tiled
+        return "scatter" if self.max_distance > 0.0 and scatter_can else "gather"
 
     @property
     def sample_count(self) -> int:
