@@ -294,6 +294,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     from .blender.bake_job import BakeJob, BakeRequest, output_path_for
     from .blender.color_attributes import AO_ATTRIBUTE
     from .blender.paths import OBJECT_TOKEN
+    from .core.bake.udim import UDIM_TOKEN
     from .core.imageio import check_writable
     from .core.bake.settings import BakeSettings
 
@@ -315,7 +316,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     # Refused before a long load; checked again with the object's name once it is known.
     mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
     if not to_colors:
-        check_writable(args.out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 1, source=source)
+        check_writable(args.out.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, "1001"), settings.size,
+                       settings.size, 1, source=source)
     check_json_target(args.json)
     with report.phase("load"):
         progress.update("loading")
@@ -352,6 +354,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                 export_mesh_file(target, mesh_out, colors=True)
             if gltf_out is not None:
                 try:
+                    if any(result.tiles for _o, _u, result in job.results):
+                        raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs of "
+                                       f"'{target.name}' lie on several; bake without --gltf-out")
                     export_glb(target, gltf_out)
                 except BaseException:  # all or nothing: the maps just written go too
                     for path in job.written:
@@ -365,16 +370,17 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     lines = []
     for obj, uv_name, result in job.results:
         st = result.stats
-        out = str(mesh_out) if to_colors else output_path_for(request, obj)
+        tile_files = job.files.get((obj.name, "ao"), [])
+        out = str(mesh_out) if to_colors else (", ".join(tile_files) if len(tile_files) > 1
+                                                else output_path_for(request, obj))
         report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
                                    uv_map_created=any(n == uv_name for _m, n in job.created_uv),
                                    covered_texels=st["covered_texels"], method=st["method"],
                                    smooth_corners=st["smooth_corners"],
-                                   **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {})))
-        report.outputs.append(out)
-        bent_out = output_path_for(request, obj, request.bent_filepath)
-        if bent_out:
-            report.outputs.append(bent_out)
+                                   **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
+                                   **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+        report.outputs.extend(tile_files if len(tile_files) > 1 else [out])
+        report.outputs.extend(job.files.get((obj.name, "bent"), []))
         if gltf_out is not None:
             report.outputs.append(str(gltf_out))
         report.warnings.extend(st.get("warnings", []))

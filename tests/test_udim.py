@@ -104,3 +104,77 @@ def test_scatter_refuses_tiles_and_auto_gathers(gpu_context):
         bake(soup, [], BakeSettings(size=SIZE, directions=8, method="scatter"), use_cache=False)
     res = bake(soup, [], BakeSettings(size=SIZE, directions=8, max_distance=1.0), use_cache=False)
     assert res.stats["method"] == "gather" and res.ao.shape == (3, SIZE, SIZE)
+
+
+def read_png(path) -> np.ndarray:
+    """(H, W) red channel of an image file as stored (row 0 = bottom)."""
+    import bpy
+    image = bpy.data.images.load(str(path), check_existing=False)
+    image.colorspace_settings.name = 'Non-Color'
+    w, h = image.size
+    px = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(px)
+    bpy.data.images.remove(image)
+    return px.reshape(h, w, 4)[..., 0]
+
+
+def test_operator_bakes_a_tiled_image_and_one_file_per_tile(scene, tmp_path):
+    """Save To 'ao.png' writes ao.1001.png, ao.1002.png, ao.1011.png (each tile's map, as the
+    core bakes it, to 16-bit precision); the image datablock is tiled, on those files, and
+    the material's AO node shows it; re-baking without a file packs the tiles into the .blend
+    and keeps the material pointing at the (replaced) image."""
+    import bpy
+    from conftest import select_only, small_settings, soup_to_object
+    from hao_addon.blender import mesh_data
+    obj = soup_to_object(combined(islands(), TILES), "udim")
+    select_only(obj)
+    settings = small_settings(scene, filepath=str(tmp_path / "ao.png"), wire_material=True)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    core = bake(mesh_data.evaluated_soup(obj, depsgraph, "UVMap"), [], settings.to_settings())
+    assert core.tiles == TILES
+    for k, tile in enumerate(TILES):
+        stored = read_png(tmp_path / f"ao.{tile}.png")
+        np.testing.assert_allclose(stored, core.ao[k], atol=1.0 / 65535 + 1e-6)
+    image = bpy.data.images[f"{obj.name}_AO"]
+    assert image.source == 'TILED' and sorted(t.number for t in image.tiles) == list(TILES)
+    assert image.filepath.endswith("ao.<UDIM>.png") and image.colorspace_settings.name == 'Non-Color'
+    node = next(n for n in obj.active_material.node_tree.nodes if n.bl_idname == 'ShaderNodeTexImage')
+    assert node.image == image
+    settings.filepath = ""
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    image = bpy.data.images[f"{obj.name}_AO"]
+    assert image.source == 'TILED' and len(image.packed_files) == 3
+    assert node.image == image and len([i for i in bpy.data.images if i.name.startswith(obj.name)]) == 1
+
+
+def test_cli_writes_one_file_per_tile_and_refuses_gltf(tmp_path):
+    """An OBJ whose UVs lie on three tiles: --out ao.<UDIM>.exr writes ao.1001.exr ... and the
+    JSON report lists them with the tiles; --gltf-out (glTF has no UDIM) exits 2 and leaves
+    no file."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    from test_cli_runs import write_obj
+    root = Path(__file__).resolve().parent.parent
+    source = tmp_path / "udim.obj"
+    write_obj(source, {"udim": combined(islands(), TILES)})
+    env = {**os.environ, "PYTHONPATH": str(root), "TMPDIR": str(tmp_path)}
+
+    def run(*extra):
+        return subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(source), "--size", "64", "--directions",
+                               "16", *map(str, extra)], capture_output=True, text=True, env=env, cwd=tmp_path,
+                              timeout=300)
+    done = run("--out", tmp_path / "ao.<UDIM>.exr", "--json", tmp_path / "r.json")
+    assert done.returncode == 0, done.stderr
+    files = [str(tmp_path / f"ao.{tile}.exr") for tile in TILES]
+    assert all(Path(f).is_file() for f in files)
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["outputs"] == files and report["objects"][0]["udim_tiles"] == list(TILES)
+    for f in files:
+        os.unlink(f)
+    refused = run("--out", tmp_path / "ao.png", "--gltf-out", tmp_path / "a.glb")
+    assert refused.returncode == 2 and "glTF has no UDIM tiles" in refused.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json", "udim.obj"]

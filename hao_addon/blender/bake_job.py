@@ -22,6 +22,7 @@ from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
+from ..core.bake.udim import UDIM_TOKEN, tile_path, udim_layout
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
@@ -140,7 +141,7 @@ def validate_request(request: BakeRequest) -> None:
                                      f"the AO map and the bent normals of '{obj.name}' would both be saved as "
                                      f"'{path}'")
             writers[path] = obj.name
-            check_writable(path, size, size, channels, source=request.source_path or None)
+            check_writable(path.replace(UDIM_TOKEN, "1001"), size, size, channels, source=request.source_path or None)
 
 
 def _validate_color_attribute(request: BakeRequest) -> None:
@@ -193,6 +194,7 @@ class BakeJob:
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.written: list[str] = []  # the files commit() wrote
+        self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
         self.committed: list[bpy.types.Image] = []
         self.finished = False
         self.unwrap_seconds = 0.0
@@ -296,8 +298,18 @@ class BakeJob:
             normals = target.normals
             if normals is None:  # flat shading: every corner has its face's normal
                 normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
-        return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin, target.uvs,
-                               req.bent_space, req.bent_convention, linear, tangents, normals)
+        if result.tiles is None:
+            return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin,
+                                   target.uvs, req.bent_space, req.bent_convention, linear, tangents, normals)
+        layout = udim_layout(target.uvs)  # one map per tile, from the tile's own triangles
+        maps = []
+        for tile in range(layout.count):
+            faces, local = layout.local_uvs(target.uvs, tile)
+            maps.append(bent_normal_map(result.bent_normals[tile], result.covered[tile], result.filled[tile],
+                                        req.settings.margin, local, req.bent_space, req.bent_convention, linear,
+                                        None if tangents is None else tangents[faces],
+                                        None if normals is None else normals[faces]))
+        return np.stack(maps)
 
     def run(self) -> None:
         for _ in self.steps():
@@ -314,29 +326,41 @@ class BakeJob:
             for obj, _uv, result in self.results:
                 color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
             return self.committed
+        files = self.files  # (object name, 'ao' | 'bent') -> the files written, one per UDIM tile
         for obj, _uv, result in self.results:
-            path = output_path_for(req, obj)
-            if path:
-                write_ao_file(path, result.ao)
-                self.written.append(path)
-            bent_path = output_path_for(req, obj, req.bent_filepath)
-            if bent_path:
-                write_ao_file(bent_path, self.bent_images[obj.name])
-                self.written.append(bent_path)
+            for kind, path, maps in (("ao", output_path_for(req, obj), result.ao),
+                                     ("bent", output_path_for(req, obj, req.bent_filepath),
+                                      self.bent_images.get(obj.name))):
+                if path:
+                    files[obj.name, kind] = self._write_maps(path, maps, result.tiles)
         for obj, uv_name, result in self.results:
             name = req.image_name or f"{obj.name}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
             existing = req.image or bpy.data.images.get(name)
-            image = images.store_map_image(result.ao, name, existing)
+            image = self._store_image(result.ao, result.tiles, name, existing, files.get((obj.name, "ao")))
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
             self.committed.append(image)
             if obj.name in self.bent_images:
                 name = f"{obj.name}_BentNormals"
-                self.committed.append(images.store_map_image(self.bent_images[obj.name], name,
-                                                             bpy.data.images.get(name)))
+                self.committed.append(self._store_image(self.bent_images[obj.name], result.tiles, name,
+                                                        bpy.data.images.get(name), files.get((obj.name, "bent"))))
         return self.committed
+
+    def _write_maps(self, path: str, maps: np.ndarray, tiles: tuple[int, ...] | None) -> list[str]:
+        """Write a map to path, or each UDIM tile's to its own file (tile_path); returns them."""
+        paths = [path] if tiles is None else [tile_path(path, tile) for tile in tiles]
+        for file_path, tile_map in zip(paths, [maps] if tiles is None else maps):
+            write_ao_file(file_path, tile_map)
+            self.written.append(file_path)
+        return paths
+
+    @staticmethod
+    def _store_image(maps: np.ndarray, tiles: tuple[int, ...] | None, name: str, existing, tile_files):
+        if tiles is None:
+            return images.store_map_image(maps, name, existing)
+        return images.store_tiled_image(maps, tiles, name, existing, tile_files)
 
     def cancel(self) -> None:
         """Undo the only early change: UV maps this job created."""

@@ -2,6 +2,10 @@
 """AO maps as Blender image datablocks, and wiring them into materials."""
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
+
 import bpy
 import numpy as np
 
@@ -71,6 +75,49 @@ def store_map_image(pixels: np.ndarray, name: str, existing: bpy.types.Image | N
     image.pixels.foreach_set(rgba.ravel())
     image.update()
     return image
+
+
+def store_tiled_image(maps: np.ndarray, tiles: tuple[int, ...], name: str,
+                      existing: bpy.types.Image | None = None, tile_files: list[str] | None = None
+                      ) -> bpy.types.Image:
+    """A UDIM bake (maps (T, H, W) accessibility or (T, H, W, 4) RGBA, row 0 = bottom, one per
+    UDIM number in tiles) as a tiled image datablock, Non-Color. The gpu-free Python API has no
+    per-tile pixel access, so the image is loaded from the tiles' files: tile_files (the ones
+    the bake saved, which the image then refers to), else 32-bit EXRs in a temporary folder,
+    packed into the .blend and deleted. An existing image of that name is replaced, its users
+    (material nodes) moved to the new one."""
+    from ..core.bake.udim import tile_path
+    from ..core.imageio import write_ao_file
+
+    folder = None
+    if tile_files is None:
+        folder = tempfile.mkdtemp(prefix="hao-udim-")
+        pattern = os.path.join(folder, f"{_file_stem(name)}.<UDIM>.exr")
+        tile_files = [tile_path(pattern, tile) for tile in tiles]
+        for path, tile_map in zip(tile_files, maps):
+            write_ao_file(path, tile_map)
+    try:
+        image = bpy.data.images.load(tile_files[0], check_existing=False)
+        image.source = 'TILED'  # finds the other tiles' files by the number in the name
+        image.colorspace_settings.name = 'Non-Color'
+        found = sorted(t.number for t in image.tiles)
+        if found != sorted(tiles):
+            bpy.data.images.remove(image)
+            raise RuntimeError(f"the tiled image '{name}' found tiles {found}, expected {sorted(tiles)}")
+        if folder is not None:
+            image.pack()
+    finally:
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
+    if existing is not None:
+        existing.user_remap(image)
+        bpy.data.images.remove(existing)
+    image.name = name
+    return image
+
+
+def _file_stem(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name) or "map"
 
 
 def image_pixels_gray(image: bpy.types.Image) -> np.ndarray:
