@@ -56,7 +56,12 @@ def build_parser() -> argparse.ArgumentParser:
                                                 "scene), .glb (COLOR_0) or .ply (vertex colours)")
     add_setting_options(b, BakeSettings)
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
-    b.add_argument("--object", default="", help="mesh to bake (default: the mesh with the most faces)")
+    b.add_argument("--object", action="append", default=None, metavar="NAME",
+                   help="mesh to bake (default: the mesh with the most faces); repeatable: each into its own "
+                        "file ({object} in --out, else _NAME is added), or with --texture-set all into one")
+    b.add_argument("--texture-set", action="store_true",
+                   help="bake the --object meshes together into one shared image (their UV islands must not "
+                        "overlap across objects); {object} in file names becomes 'TextureSet'")
     b.add_argument("--occluders", choices=("target", "visible"), default="visible",
                    help="target: self-occlusion only (with --high-poly: the high-poly only); visible: every "
                         "visible mesh occludes (default)")
@@ -237,15 +242,17 @@ def check_gltf_target(path: str, source: Path) -> Path:
     return check_mesh_target(path, source, (".glb",), "--gltf-out")
 
 
-def export_mesh_file(obj, path: Path, colors: bool = False) -> None:
-    """Write obj alone as a .glb (Blender's glTF exporter; colors: with its active colour
-    attribute as COLOR_0) or a .ply (linear vertex colours when colors), or the whole session
-    as a .blend copy; atomically (a temporary file in the same folder, renamed over path)."""
+def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
+    """Write the objects alone as a .glb (Blender's glTF exporter; colors: with their active
+    colour attribute as COLOR_0) or a .ply (linear vertex colours when colors), or the whole
+    session as a .blend copy; atomically (a temporary file in the same folder, renamed over
+    path)."""
     import bpy
 
     for other in bpy.context.view_layer.objects:
-        other.select_set(other == obj)
-    bpy.context.view_layer.objects.active = obj
+        other.select_set(other in objects)
+    bpy.context.view_layer.objects.active = objects[0]
+    obj = objects[0]
     suffix = path.suffix.lower()
     tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}{suffix}")
     try:
@@ -265,9 +272,9 @@ def export_mesh_file(obj, path: Path, colors: bool = False) -> None:
             tmp.unlink()
 
 
-def export_glb(obj, path: Path) -> None:
-    """Write obj alone as a .glb with its baked map (export_mesh_file)."""
-    export_mesh_file(obj, path)
+def export_glb(objects: list, path: Path) -> None:
+    """Write the objects alone as a .glb with their baked maps (export_mesh_file)."""
+    export_mesh_file(objects, path)
 
 
 def pick_target(name: str, exclude: tuple = ()):
@@ -327,11 +334,19 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     cage = pick_mesh(args.cage, "--cage") if args.cage else None
     if cage is not None and high_poly is None:
         raise CLIError("--cage needs --high-poly (Selected to Active)")
-    target = pick_target(args.object, tuple(high_poly or ()) + ((cage,) if cage else ()))
+    exclude = tuple(high_poly or ()) + ((cage,) if cage else ())
+    targets = [pick_target(name, exclude) for name in (args.object or [""])]
+    if len({o.name for o in targets}) != len(targets):
+        raise CLIError("--object names the same mesh twice")
+    if args.texture_set and len(targets) < 2:
+        raise CLIError("--texture-set bakes several meshes into one image: name them with --object (twice or more)")
+    if high_poly is not None and len(targets) > 1:
+        raise CLIError("Selected to Active bakes onto one low-poly: give one --object")
+    target = targets[0]
     if high_poly is not None:
         report.settings["high_poly"] = [o.name for o in high_poly]
         report.settings["cage"] = cage.name if cage else ""
-    request = BakeRequest(targets=[target], settings=settings,
+    request = BakeRequest(targets=targets, settings=settings, texture_set=args.texture_set,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                           filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
@@ -351,13 +366,13 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         with report.phase("write"):
             job.commit()
             if mesh_out is not None:
-                export_mesh_file(target, mesh_out, colors=True)
+                export_mesh_file(targets, mesh_out, colors=True)
             if gltf_out is not None:
                 try:
                     if any(result.tiles for _o, _u, result in job.results):
-                        raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs of "
-                                       f"'{target.name}' lie on several; bake without --gltf-out")
-                    export_glb(target, gltf_out)
+                        raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs baked lie on "
+                                       "several; bake without --gltf-out")
+                    export_glb(targets, gltf_out)
                 except BaseException:  # all or nothing: the maps just written go too
                     for path in job.written:
                         if os.path.exists(path):
@@ -367,27 +382,31 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         job.cancel()
         raise
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
-    lines = []
     for obj, uv_name, result in job.results:
         st = result.stats
-        tile_files = job.files.get((obj.name, "ao"), [])
-        out = str(mesh_out) if to_colors else (", ".join(tile_files) if len(tile_files) > 1
-                                                else output_path_for(request, obj))
-        report.objects.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
-                                   uv_map_created=any(n == uv_name for _m, n in job.created_uv),
+        report.objects.append(dict(name=obj.name, triangles=st["target_faces"],
+                                   uv_map=uv_name, uv_map_created=any(n == uv_name for _m, n in job.created_uv),
                                    covered_texels=st["covered_texels"], method=st["method"],
                                    smooth_corners=st["smooth_corners"],
+                                   **({"texture_set": True} if args.texture_set else {}),
                                    **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
                                    **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+    lines = []
+    for obj, label, result in job.baked():
+        st = result.stats
+        tile_files = job.files.get((label, "ao"), [])
+        out = str(mesh_out) if to_colors else (", ".join(tile_files) if len(tile_files) > 1
+                                                else output_path_for(request, obj))
         report.outputs.extend(tile_files if len(tile_files) > 1 else [out])
-        report.outputs.extend(job.files.get((obj.name, "bent"), []))
-        if gltf_out is not None:
-            report.outputs.append(str(gltf_out))
+        report.outputs.extend(job.files.get((label, "bent"), []))
         report.warnings.extend(st.get("warnings", []))
+        uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
                  f"'{AO_ATTRIBUTE}')" if to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
-        lines.append(f"hao: baked '{obj.name}' ({st['target_faces']} triangles, {where}, {settings.directions} "
+        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {settings.directions} "
                      f"directions in {time.perf_counter() - t0:.2f} s -> {out}")
+    if gltf_out is not None:
+        report.outputs.append(str(gltf_out))
     return lines
 
 

@@ -62,6 +62,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
             else:
                 col.prop(settings, "uv_map", text="Name")
         col.prop(settings, "margin")
+        col.prop(settings, "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
         col.prop(settings, "filepath")
         col.prop(settings, "wire_material")

@@ -55,6 +55,11 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "
                                                  "{object} is replaced by the object's name", default="",
         subtype='FILE_PATH', options=compat.path_property_options())
+    texture_set: BoolProperty(
+        name="Texture Set",
+        description="Bake the selected meshes together into one shared image 'TextureSet_AO', each on its own UVs "
+                    "(islands must not overlap across objects); each occludes the others",
+        default=False)
     wire_material: BoolProperty(
         name="Add to Material", description="Add the AO image to the object's material and multiply it into Base Color",
         default=False)
@@ -78,7 +83,8 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                            wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
-                           bent_space=self.bent_space, bent_convention=self.bent_convention)
+                           bent_space=self.bent_space, bent_convention=self.bent_convention,
+                           texture_set=self.texture_set and to_image and not self.selected_to_active)
 
 
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))

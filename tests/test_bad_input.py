@@ -177,6 +177,10 @@ CASES = [
     ("output-is-folder-png", [BAKE, "{in}/spot.obj", "--out", "{in}/dir.png"], 2, "it is a folder"),
     ("report-folder-missing", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/no/r.json"], 2,
      "cannot write the report"),
+    ("texture-set-one-object", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--texture-set"], 2,
+     "--texture-set bakes several meshes"),
+    ("object-twice", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--object", "spot", "--object", "spot"], 2,
+     "names the same mesh twice"),
     # the colour-attribute target: --out is the mesh file to save
     ("color-attribute-image-out", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--target", "color-attribute"], 2,
      "--out must be a .blend or .glb or .ply file"),

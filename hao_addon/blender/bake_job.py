@@ -22,6 +22,7 @@ from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
+from ..core.bake.texture_set import texture_set_target
 from ..core.bake.udim import UDIM_TOKEN, tile_path, udim_layout
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
@@ -30,6 +31,8 @@ from .paths import OBJECT_TOKEN, absolute_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
+# What a texture set's image and files are named after (BakeRequest.texture_set).
+TEXTURE_SET_NAME = "TextureSet"
 
 
 @dataclass
@@ -48,7 +51,9 @@ class BakeRequest:
     in bent_space ('tangent': the baked UV map's MikkTSpace; 'object') and bent_convention
     ('opengl' Y+, 'directx' Y-), saved to bent_filepath if given (tokens as filepath).
     settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
-    instead (settings.color_domain), UV map, image and files unused."""
+    instead (settings.color_domain), UV map, image and files unused.
+    texture_set: the targets, each with its own UVs (not overlapping across objects), bake
+    together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet')."""
 
     targets: list
     settings: BakeSettings
@@ -64,6 +69,7 @@ class BakeRequest:
     bent_filepath: str = ""
     bent_space: str = "tangent"
     bent_convention: str = "opengl"
+    texture_set: bool = False
 
     @property
     def to_color_attribute(self) -> bool:
@@ -91,6 +97,8 @@ def output_path_for(request: BakeRequest, obj, filepath: str | None = None) -> s
     if not filepath:
         return ""
     path = absolute_path(filepath)
+    if request.texture_set:
+        return path.replace(OBJECT_TOKEN, TEXTURE_SET_NAME)
     if len(request.targets) > 1 and OBJECT_TOKEN not in path:
         stem, ext = os.path.splitext(path)
         path = f"{stem}_{OBJECT_TOKEN}{ext}"
@@ -122,15 +130,17 @@ def validate_request(request: BakeRequest) -> None:
             raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto (xatlas) to unwrap it")
     if request.occluders not in OCCLUDER_MODES:
         raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
-    if request.image is not None and len(request.targets) > 1:
-        raise BakeInputError("an existing image can receive only one object's bake")
+    if request.texture_set:
+        _validate_texture_set(request)
+    elif request.image is not None and len(request.targets) > 1:
+        raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
     if request.bent_filepath and not request.settings.bent_normals:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
     if request.bent_space not in SPACES or request.bent_convention not in CONVENTIONS:
         raise BakeInputError(f"bent normals: space must be one of {SPACES}, convention one of {CONVENTIONS}")
     writers: dict[str, str] = {}
     size = request.settings.size
-    for obj in request.targets:
+    for obj in request.targets[:1] if request.texture_set else request.targets:  # a set's files are shared
         for filepath, channels in ((request.filepath, 1), (request.bent_filepath, 4)):
             path = output_path_for(request, obj, filepath)
             if not path:
@@ -142,6 +152,15 @@ def validate_request(request: BakeRequest) -> None:
                                      f"'{path}'")
             writers[path] = obj.name
             check_writable(path.replace(UDIM_TOKEN, "1001"), size, size, channels, source=request.source_path or None)
+
+
+def _validate_texture_set(request: BakeRequest) -> None:
+    if request.to_color_attribute or request.high_poly is not None:
+        raise BakeInputError("a texture set bakes the objects' own surfaces into one image: not with a colour "
+                             "attribute or Selected to Active")
+    if request.settings.bent_normals and request.bent_space == "object":
+        raise BakeInputError("object-space bent normals of a texture set would mix the objects' spaces: use "
+                             "tangent space")
 
 
 def _validate_color_attribute(request: BakeRequest) -> None:
@@ -258,18 +277,21 @@ class BakeJob:
         for obj in req.targets:  # a colour attribute needs no UV map
             uv_names[obj.name] = "" if req.to_color_attribute else (yield from self._uv_name_for(obj))
         depsgraph = self._depsgraph_getter()
-        n = len(req.targets)
-        for k, obj in enumerate(req.targets):
-            target = mesh_data.evaluated_soup(obj, depsgraph, uv_names[obj.name] or None,
-                                              shading_normals=req.settings.normals == "mesh")
+        units = [req.targets] if req.texture_set else [[obj] for obj in req.targets]
+        for k, objects in enumerate(units):
+            obj = objects[0]
+            label = TEXTURE_SET_NAME if req.texture_set else obj.name
+            parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
+                                              shading_normals=req.settings.normals == "mesh") for o in objects]
+            target = texture_set_target(parts, req.settings.size, label) if req.texture_set else parts[0]
             vertex_target = None
             if req.to_color_attribute:
                 vertex_target = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
             high_to_low = self._high_to_low(obj, depsgraph) if req.high_poly is not None else None
-            skip = set(req.high_poly or ()) | {req.cage}
+            skip = set(req.high_poly or ()) | {req.cage} | set(objects)
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
                          for o in self._occluder_objects(obj) if o not in skip]
-            settings = terminator_settings(req.settings, req.high_poly or [obj])
+            settings = terminator_settings(req.settings, req.high_poly or objects)
             gen = bake_steps(target, occluders, settings, high_to_low=high_to_low, vertex_target=vertex_target)
             try:
                 while True:
@@ -278,21 +300,25 @@ class BakeJob:
                     except StopIteration as stop:
                         result = stop.value
                         break
-                    yield (k + frac) / n, f"Baking AO of '{obj.name}' ({k + 1}/{n}): {frac * 100:.0f}%"
+                    yield (k + frac) / len(units), f"Baking AO of '{label}' ({k + 1}/{len(units)}): {frac * 100:.0f}%"
             finally:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
             if settings.bent_normals:
-                self.bent_images[obj.name] = self._bent_image(obj, depsgraph, uv_names[obj.name], target, result)
-            self.results.append((obj, uv_names[obj.name], result))
+                self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
+                                                           target, result)
+            # A texture set's objects share one result (commit writes it once).
+            self.results.extend((o, uv_names[o.name], result) for o in objects)
         self.finished = True
 
-    def _bent_image(self, obj, depsgraph, uv_name: str, target, result: BakeResult):
-        """(size, size, 4) encoded bent-normal image of a finished bake, in the request's space."""
+    def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target, result: BakeResult):
+        """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
+        texture set's, whose target is their soups in that order), in the request's space."""
         req = self.request
-        linear = np.array(obj.evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
+        linear = np.array(objects[0].evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
         tangents = normals = None
         if req.bent_space == "tangent":
-            tangents = mesh_data.corner_tangents(obj, depsgraph, uv_name)
+            tangents = np.concatenate([mesh_data.corner_tangents(o, depsgraph, uv)
+                                       for o, uv in zip(objects, uv_names)])
             # The world corner normals as they are (not re-normalized: on a scaled object that
             # would turn the decoded direction, 4 degrees on tests/test_bent_normals' sphere).
             normals = target.normals
@@ -326,27 +352,43 @@ class BakeJob:
             for obj, _uv, result in self.results:
                 color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
             return self.committed
-        files = self.files  # (object name, 'ao' | 'bent') -> the files written, one per UDIM tile
-        for obj, _uv, result in self.results:
+        files = self.files  # (label, 'ao' | 'bent') -> the files written, one per UDIM tile
+        for obj, label, result in self.baked():
             for kind, path, maps in (("ao", output_path_for(req, obj), result.ao),
                                      ("bent", output_path_for(req, obj, req.bent_filepath),
-                                      self.bent_images.get(obj.name))):
+                                      self.bent_images.get(label))):
                 if path:
-                    files[obj.name, kind] = self._write_maps(path, maps, result.tiles)
-        for obj, uv_name, result in self.results:
-            name = req.image_name or f"{obj.name}_AO"
+                    files[label, kind] = self._write_maps(path, maps, result.tiles)
+        stored = {}
+        for obj, label, result in self.baked():
+            name = req.image_name or f"{label}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
             existing = req.image or bpy.data.images.get(name)
-            image = self._store_image(result.ao, result.tiles, name, existing, files.get((obj.name, "ao")))
+            stored[label] = self._store_image(result.ao, result.tiles, name, existing, files.get((label, "ao")))
+            self.committed.append(stored[label])
+            if label in self.bent_images:
+                name = f"{label}_BentNormals"
+                self.committed.append(self._store_image(self.bent_images[label], result.tiles, name,
+                                                        bpy.data.images.get(name), files.get((label, "bent"))))
+        for obj, uv_name, _result in self.results:
+            image = stored[self.label_of(obj)]
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
-            self.committed.append(image)
-            if obj.name in self.bent_images:
-                name = f"{obj.name}_BentNormals"
-                self.committed.append(self._store_image(self.bent_images[obj.name], result.tiles, name,
-                                                        bpy.data.images.get(name), files.get((obj.name, "bent"))))
         return self.committed
+
+    def label_of(self, obj) -> str:
+        """The name a target's outputs carry: its own, or the texture set's."""
+        return TEXTURE_SET_NAME if self.request.texture_set else obj.name
+
+    def baked(self) -> list:
+        """(first object, label, result) of each bake (a texture set's objects share one)."""
+        seen, out = set(), []
+        for obj, _uv, result in self.results:
+            if id(result) not in seen:
+                seen.add(id(result))
+                out.append((obj, self.label_of(obj), result))
+        return out
 
     def _write_maps(self, path: str, maps: np.ndarray, tiles: tuple[int, ...] | None) -> list[str]:
         """Write a map to path, or each UDIM tile's to its own file (tile_path); returns them."""
