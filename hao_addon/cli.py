@@ -342,7 +342,6 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         raise CLIError("--texture-set bakes several meshes into one image: name them with --object (twice or more)")
     if high_poly is not None and len(targets) > 1:
         raise CLIError("Selected to Active bakes onto one low-poly: give one --object")
-    target = targets[0]
     if high_poly is not None:
         report.settings["high_poly"] = [o.name for o in high_poly]
         report.settings["cage"] = cage.name if cage else ""
