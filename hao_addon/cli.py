@@ -26,6 +26,9 @@ from .core.errors import BakeInputError
 from .core.setting_spec import SettingError
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
+# A batch's file names in --out-dir, unless --out gives them ({input}: the input's stem).
+INPUT_TOKEN = "{input}"
+BATCH_NAME = "{input}_ao.png"  # several meshes of an input: _{object} is added
 INPUT_FORMATS = (".obj", ".glb", ".gltf", ".blend")
 DEBUG_ENV = "HAO_DEBUG"  # set to 1: an internal error also prints its traceback and Blender's log
 
@@ -49,11 +52,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"hao {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     b = sub.add_parser("bake", help="bake per-texel AO of a mesh into an image file")
-    b.add_argument("input", help=".obj, .glb/.gltf or .blend file")
-    b.add_argument("--out", required=True, help="output .png (16-bit) or .exr (32-bit float); "
-                                                "{object} becomes the baked object's name. With --target "
-                                                "color-attribute: the mesh file to save, .blend (the whole "
-                                                "scene), .glb (COLOR_0) or .ply (vertex colours)")
+    b.add_argument("input", nargs="+", help=".obj, .glb/.gltf or .blend file; several make a batch (--out-dir)")
+    b.add_argument("--out", default=None,
+                   help="output .png (16-bit) or .exr (32-bit float); {object} becomes the baked object's name, "
+                        "{input} the input file's name without extension. With --target color-attribute: the "
+                        "mesh file to save, .blend (the whole scene), .glb (COLOR_0) or .ply (vertex colours). "
+                        f"With --out-dir: a file name in it (default {BATCH_NAME})")
+    b.add_argument("--out-dir", default=None, metavar="DIR",
+                   help="a batch: every input is baked (a failed one does not stop the others; exit 1 if any "
+                        "failed), its files written into DIR as --out names them")
+    b.add_argument("--all-meshes", action="store_true",
+                   help="bake every mesh of each input (each into its own file), not only the largest")
     add_setting_options(b, BakeSettings)
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
     b.add_argument("--object", action="append", default=None, metavar="NAME",
@@ -335,7 +344,12 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     if cage is not None and high_poly is None:
         raise CLIError("--cage needs --high-poly (Selected to Active)")
     exclude = tuple(high_poly or ()) + ((cage,) if cage else ())
-    targets = [pick_target(name, exclude) for name in (args.object or [""])]
+    if args.all_meshes:
+        targets = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
+        if not targets:
+            raise CLIError("the input contains no mesh object")
+    else:
+        targets = [pick_target(name, exclude) for name in (args.object or [""])]
     if len({o.name for o in targets}) != len(targets):
         raise CLIError("--object names the same mesh twice")
     if args.texture_set and len(targets) < 2:
@@ -478,7 +492,53 @@ def _validated(settings, settings_cls):
         raise CLIError(f"{exc} ({option})" if option else str(exc)) from None
 
 
-COMMANDS = {"bake": run_bake, "render-ao": run_render_ao}
+def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
+    """`bake`: one input with --out, or a batch (--out-dir, or several inputs)."""
+    if args.out_dir is None and len(args.input) == 1:
+        if not args.out:
+            raise CLIError("bake needs --out FILE (or --out-dir DIR)")
+        args.input, args.out = args.input[0], args.out.replace(INPUT_TOKEN, Path(args.input[0]).stem)
+        return run_bake(args, report, progress)
+    return run_batch(args, report, progress)
+
+
+def run_batch(args, report: Report, progress: Progress) -> list[str]:
+    """Bake every input in this process (the GPU context, compiled shaders and caches carry
+    over), each into --out-dir; a failed input is reported and the next one baked. A signal
+    stops the batch at once. Returns the summary lines; report.inputs holds one report each."""
+    if args.out_dir is None:
+        raise CLIError("several inputs make a batch: give --out-dir DIR for their files")
+    folder = Path(os.path.abspath(args.out_dir))
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise CLIError(f"--out-dir '{args.out_dir}' does not exist or is not writable")
+    template = args.out or BATCH_NAME
+    if os.path.dirname(template):
+        raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
+    stems = [Path(path).stem for path in args.input]
+    if INPUT_TOKEN not in template and len(set(stems)) > 1:
+        raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
+    lines = []
+    for path, stem in zip(args.input, stems):
+        one = Report(command="bake", input=str(path), hao=report.hao, blender=report.blender)
+        started = time.perf_counter()
+        sub = argparse.Namespace(**vars(args))
+        sub.input, sub.out = path, str(folder / template.replace(INPUT_TOKEN, stem))
+        try:
+            lines += run_bake(sub, one, progress)
+        except (KeyboardInterrupt, Terminated):
+            raise
+        except BaseException as exc:  # noqa: BLE001 - one input's failure is its line, the batch goes on
+            code, message = _failure(exc, None)
+            one.status, one.exit_code, one.error = "error", code, message
+            report.input_errors.append(f"{path}: {message}")
+        one.timings["total"] = round(time.perf_counter() - started, 4)
+        report.inputs.append(one.as_dict())
+        report.outputs.extend(one.outputs)
+        report.warnings.extend(f"{path}: {w}" for w in one.warnings)
+    return lines
+
+
+COMMANDS = {"bake": run_bake_command, "render-ao": run_render_ao}
 
 
 # -- entry point ------------------------------------------------------------------------------------
@@ -504,11 +564,19 @@ def main(argv: list[str] | None = None) -> int:
                     io.err.write(f"hao: warning: {warning}\n")
                 if args.json != "-":
                     io.out.write("".join(line + "\n" for line in lines))
-            code = EXIT_OK
+            for failed in report.input_errors:  # a batch's failed inputs, one line each
+                io.err.write(f"hao: error: {failed}\n")
+            code = EXIT_FAILURE if report.input_errors else EXIT_OK
+            if report.input_errors:
+                report.status = "partial"
+                report.error = f"{len(report.input_errors)} of {len(report.inputs)} inputs failed"
         except SystemExit as exc:  # --help / --version
             return int(exc.code or 0)
         except BaseException as exc:  # noqa: BLE001 - every failure becomes one line and an exit code
             code, message = _failure(exc, io)
+            if report.inputs and code in EXIT_INTERRUPTED.values():  # a batch: the inputs before stay baked
+                message = message.replace("nothing was written", f"the {len(report.inputs)} inputs before it are "
+                                                                 f"written, nothing of the one it stopped")
             report.status, report.error = ("interrupted" if code in EXIT_INTERRUPTED.values() else "error"), message
             io.err.write(f"hao: error: {message}\n")
         report.exit_code = code
@@ -528,8 +596,9 @@ def _parse(argv: list[str], io: ProcessOutput) -> argparse.Namespace:
         sys.stdout, sys.stderr = saved
 
 
-def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
-    """(exit code, one-line message) for any exception."""
+def _failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
+    """(exit code, one-line message) for any exception (io: where HAO_DEBUG writes the
+    traceback; None for a batch input's failure, which carries on)."""
     import signal
 
     if pending_signal() is not None and not isinstance(exc, (KeyboardInterrupt, Terminated)):
@@ -548,7 +617,7 @@ def _failure(exc: BaseException, io: ProcessOutput) -> tuple[int, str]:
         return EXIT_NO_GPU, _last_line(exc)
     if isinstance(exc, (BakeInputError, OSError)):  # UnwrapError and SettingError included
         return EXIT_BAD_INPUT, _last_line(exc)
-    if os.environ.get(DEBUG_ENV):
+    if os.environ.get(DEBUG_ENV) and io is not None:
         io.err.write(io.log() + "".join(traceback.format_exception(exc)))
     return EXIT_FAILURE, (f"internal error ({type(exc).__name__}: {_last_line(exc)}); "
                           f"run with {DEBUG_ENV}=1 for details")

@@ -195,6 +195,9 @@ class Report:
     timings: dict = field(default_factory=dict)
     outputs: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    # A batch: one report per input (as_dict), and the failed ones' lines.
+    inputs: list = field(default_factory=list)
+    input_errors: list = field(default_factory=list)
 
     @contextlib.contextmanager
     def phase(self, name: str) -> Iterator[None]:
@@ -204,5 +207,11 @@ class Report:
         finally:
             self.timings[name] = round(self.timings.get(name, 0.0) + time.perf_counter() - t0, 4)
 
+    def as_dict(self) -> dict:
+        out = asdict(self)
+        if not self.inputs:  # a single bake's report keeps its shape
+            del out["inputs"], out["input_errors"]
+        return out
+
     def to_json(self) -> str:
-        return json.dumps(asdict(self), indent=2, default=str) + "\n"
+        return json.dumps(self.as_dict(), indent=2, default=str) + "\n"
