@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import time
 import traceback
@@ -61,6 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--out-dir", default=None, metavar="DIR",
                    help="a batch: every input is baked (a failed one does not stop the others; exit 1 if any "
                         "failed), its files written into DIR as --out names them")
+    b.add_argument("--frames", default=None, metavar="A-B[:STEP]",
+                   help="bake frames A to B (every STEP-th) of the scene's animation, one map per frame: "
+                        "{frame} in --out becomes the frame, zero-padded to 4 digits (else _{frame} is added); a "
+                        "frame whose evaluated meshes equal an earlier one's reuses its bake")
     b.add_argument("--all-meshes", action="store_true",
                    help="bake every mesh of each input (each into its own file), not only the largest")
     add_setting_options(b, BakeSettings)
@@ -286,6 +291,26 @@ def export_glb(objects: list, path: Path) -> None:
     export_mesh_file(objects, path)
 
 
+# At most this many frames in one --frames range (a typo such as 1-100000 is refused).
+MAX_FRAMES = 10_000
+
+
+def parse_frames(spec: str) -> list[int]:
+    """The frames of 'A-B[:STEP]' (or one frame 'A'), A <= B, STEP >= 1."""
+    match = re.fullmatch(r"\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*(?::\s*(\d+))?\s*", spec)
+    if match is None:
+        raise CLIError(f"--frames '{spec}': expected A-B or A-B:STEP (for example 1-48 or 1-48:2)")
+    first = int(match.group(1))
+    last = int(match.group(2)) if match.group(2) is not None else first
+    step = int(match.group(3)) if match.group(3) is not None else 1
+    if last < first or step < 1:
+        raise CLIError(f"--frames '{spec}': the range must run forwards (A <= B) with a step of at least 1")
+    frames = list(range(first, last + 1, step))
+    if len(frames) > MAX_FRAMES:
+        raise CLIError(f"--frames '{spec}' asks for {len(frames)} frames, more than {MAX_FRAMES}")
+    return frames
+
+
 def pick_target(name: str, exclude: tuple = ()):
     """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
     import bpy
@@ -316,6 +341,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 
     settings = _validated(settings_from_args(args, BakeSettings), BakeSettings)
     source = check_input(Path(args.input), INPUT_FORMATS)
+    frames = parse_frames(args.frames) if args.frames else None
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
     to_colors = settings.target == "color-attribute"
@@ -332,8 +358,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     # Refused before a long load; checked again with the object's name once it is known.
     mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
     if not to_colors:
-        check_writable(args.out.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, "1001"), settings.size,
-                       settings.size, 1, source=source)
+        check_writable(args.out.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, "1001").replace("{frame}", "0000"),
+                       settings.size, settings.size, 1, source=source)
     check_json_target(args.json)
     with report.phase("load"):
         progress.update("loading")
@@ -360,6 +386,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         report.settings["high_poly"] = [o.name for o in high_poly]
         report.settings["cage"] = cage.name if cage else ""
     request = BakeRequest(targets=targets, settings=settings, texture_set=args.texture_set,
+                          frames=frames,
                           occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                           filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
@@ -408,9 +435,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     for obj, label, result in job.baked():
         st = result.stats
         tile_files = job.files.get((label, "ao"), [])
-        out = str(mesh_out) if to_colors else (", ".join(tile_files) if len(tile_files) > 1
-                                                else output_path_for(request, obj))
-        report.outputs.extend(tile_files if len(tile_files) > 1 else [out])
+        several = len(tile_files) > 1 or request.frames  # UDIM tiles or frames: every file
+        out = str(mesh_out) if to_colors else (", ".join(tile_files) if several else output_path_for(request, obj))
+        report.outputs.extend(tile_files if several else [out])
         report.outputs.extend(job.files.get((label, "bent"), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
@@ -420,6 +447,13 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                      f"directions in {time.perf_counter() - t0:.2f} s -> {out}")
     if gltf_out is not None:
         report.outputs.append(str(gltf_out))
+    if request.frames:
+        report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"],
+                              outputs=e.get("outputs", [])) for e in job.frame_results]
+        reused = sum(e["reused"] for e in job.frame_results)
+        lines = [line.split(" -> ")[0] + f" x {len(request.frames)} frames ({reused} reused, same geometry) -> "
+                 + output_path_for(request, obj).replace("{frame}", "####") for line, (obj, _l, _r)
+                 in zip(lines, job.baked())]
     return lines
 
 

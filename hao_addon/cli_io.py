@@ -198,6 +198,8 @@ class Report:
     # A batch: one report per input (as_dict), and the failed ones' lines.
     inputs: list = field(default_factory=list)
     input_errors: list = field(default_factory=list)
+    # A frame sequence: per frame {frame, seconds, reused, outputs}.
+    frames: list = field(default_factory=list)
 
     @contextlib.contextmanager
     def phase(self, name: str) -> Iterator[None]:
@@ -211,6 +213,8 @@ class Report:
         out = asdict(self)
         if not self.inputs:  # a single bake's report keeps its shape
             del out["inputs"], out["input_errors"]
+        if not self.frames:
+            del out["frames"]
         return out
 
     def to_json(self) -> str:

@@ -96,6 +96,11 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         for _obj, _uv, result in job.results:
             for warning in result.stats.get("warnings", []):
                 self.report({'WARNING'}, warning)
+        if job.request.frames:
+            files = sum(len(v) for k, v in job.files.items() if k[1] == "ao")
+            self.report({'INFO'}, f"Baked AO of {len(job.request.frames)} frames into {files} files "
+                                  f"({sum(e['reused'] for e in job.frame_results)} frames reused an earlier bake)")
+            return
         if job.request.to_color_attribute:
             names = ", ".join(f"'{obj.name}'" for obj, _uv, _result in job.results)
             self.report({'INFO'}, f"Baked AO into the colour attribute '{AO_ATTRIBUTE}' of {names}")

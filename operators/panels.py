@@ -65,6 +65,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
         col.prop(settings, "filepath")
+        col.prop(settings, "frame_range")
         col.prop(settings, "wire_material")
         col.prop(settings, "bent_normals")
         sub = col.column()

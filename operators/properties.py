@@ -60,6 +60,11 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         description="Bake the selected meshes together into one shared image 'TextureSet_AO', each on its own UVs "
                     "(islands must not overlap across objects); each occludes the others",
         default=False)
+    frame_range: BoolProperty(
+        name="Frame Range",
+        description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
+                    "{frame} in Save To becomes the frame number; frames with unchanged meshes reuse their bake",
+        default=False)
     wire_material: BoolProperty(
         name="Add to Material", description="Add the AO image to the object's material and multiply it into Base Color",
         default=False)
@@ -84,7 +89,13 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
                            bent_space=self.bent_space, bent_convention=self.bent_convention,
-                           texture_set=self.texture_set and to_image and not self.selected_to_active)
+                           texture_set=self.texture_set and to_image and not self.selected_to_active,
+                           frames=self.scene_frames() if self.frame_range else None)
+
+    def scene_frames(self) -> list[int]:
+        """The frames of the scene this property group belongs to (its frame range and step)."""
+        scene = self.id_data
+        return list(range(scene.frame_start, scene.frame_end + 1, max(1, scene.frame_step)))
 
 
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))

@@ -181,6 +181,10 @@ CASES = [
      "--texture-set bakes several meshes"),
     ("object-twice", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--object", "spot", "--object", "spot"], 2,
      "names the same mesh twice"),
+    ("frames-backwards", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "9-1"], 2,
+     "the range must run forwards"),
+    ("frames-not-a-range", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "first-last"], 2,
+     "expected A-B or A-B:STEP"),
     # the colour-attribute target: --out is the mesh file to save
     ("color-attribute-image-out", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--target", "color-attribute"], 2,
      "--out must be a .blend or .glb or .ply file"),

@@ -27,7 +27,7 @@ from ..core.bake.udim import UDIM_TOKEN, tile_path, udim_layout
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
-from .paths import OBJECT_TOKEN, absolute_path, object_file_name
+from .paths import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN, absolute_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
@@ -53,7 +53,11 @@ class BakeRequest:
     settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
     instead (settings.color_domain), UV map, image and files unused.
     texture_set: the targets, each with its own UVs (not overlapping across objects), bake
-    together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet')."""
+    together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet').
+    frames: a frame sequence: the scene is set to each frame in turn (restored after), each
+    frame's maps go to files ({frame} in the paths, zero-padded; '_{frame}' added otherwise),
+    no image datablocks; a frame whose evaluated geometry equals an earlier one reuses its
+    bake (the bake cache)."""
 
     targets: list
     settings: BakeSettings
@@ -70,6 +74,7 @@ class BakeRequest:
     bent_space: str = "tangent"
     bent_convention: str = "opengl"
     texture_set: bool = False
+    frames: list | None = None
 
     @property
     def to_color_attribute(self) -> bool:
@@ -89,14 +94,20 @@ def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeS
     return replace(settings, terminator_offset=max(offsets)) if offsets else settings
 
 
-def output_path_for(request: BakeRequest, obj, filepath: str | None = None) -> str:
+def output_path_for(request: BakeRequest, obj, filepath: str | None = None, frame: int | None = None) -> str:
     """The file an object's map is saved to (request.filepath, or the given one): '{object}'
     becomes its name; with several targets and no token, '_{object}' is added before the
-    extension."""
+    extension. A frame sequence: '{frame}' becomes the frame (zero-padded; '_{frame}' is added
+    where the path has none); frame None leaves the token (for checks)."""
     filepath = request.filepath if filepath is None else filepath
     if not filepath:
         return ""
     path = absolute_path(filepath)
+    if request.frames and FRAME_TOKEN not in path:
+        stem, ext = os.path.splitext(path)
+        path = f"{stem}_{FRAME_TOKEN}{ext}"
+    if frame is not None:
+        path = path.replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}")
     if request.texture_set:
         return path.replace(OBJECT_TOKEN, TEXTURE_SET_NAME)
     if len(request.targets) > 1 and OBJECT_TOKEN not in path:
@@ -130,6 +141,8 @@ def validate_request(request: BakeRequest) -> None:
             raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto (xatlas) to unwrap it")
     if request.occluders not in OCCLUDER_MODES:
         raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
+    if request.frames is not None:
+        _validate_frames(request)
     if request.texture_set:
         _validate_texture_set(request)
     elif request.image is not None and len(request.targets) > 1:
@@ -151,7 +164,17 @@ def validate_request(request: BakeRequest) -> None:
                                      f"the AO map and the bent normals of '{obj.name}' would both be saved as "
                                      f"'{path}'")
             writers[path] = obj.name
-            check_writable(path.replace(UDIM_TOKEN, "1001"), size, size, channels, source=request.source_path or None)
+            check_writable(path.replace(UDIM_TOKEN, "1001").replace(FRAME_TOKEN, "0" * FRAME_DIGITS), size, size,
+                           channels, source=request.source_path or None)
+
+
+def _validate_frames(request: BakeRequest) -> None:
+    if not request.frames:
+        raise BakeInputError("a frame sequence needs at least one frame")
+    if request.to_color_attribute:
+        raise BakeInputError("a colour attribute holds one frame: bake a frame sequence into image files")
+    if not request.filepath:
+        raise BakeInputError("a frame sequence writes one file per frame: set Save To (a path with {frame})")
 
 
 def _validate_texture_set(request: BakeRequest) -> None:
@@ -214,6 +237,8 @@ class BakeJob:
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.written: list[str] = []  # the files commit() wrote
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
+        # A frame sequence: per frame {frame, seconds, reused, results, bent_images}.
+        self.frame_results: list[dict] = []
         self.committed: list[bpy.types.Image] = []
         self.finished = False
         self.unwrap_seconds = 0.0
@@ -276,8 +301,34 @@ class BakeJob:
         uv_names = {}
         for obj in req.targets:  # a colour attribute needs no UV map
             uv_names[obj.name] = "" if req.to_color_attribute else (yield from self._uv_name_for(obj))
+        if not req.frames:
+            yield from self._bake_frame(uv_names, 0.0, 1.0)
+            self.finished = True
+            return
+        scene = bpy.context.scene
+        original = scene.frame_current
+        try:
+            for k, frame in enumerate(req.frames):
+                scene.frame_set(frame)
+                t0 = time.perf_counter()
+                self.results = []
+                yield from self._bake_frame(uv_names, k / len(req.frames), 1.0 / len(req.frames), frame)
+                self.frame_results.append(dict(frame=frame, seconds=round(time.perf_counter() - t0, 4),
+                                               reused=all(r.stats.get("cache_hit") for _o, _u, r in self.results),
+                                               results=self.results, bent_images=dict(self.bent_images)))
+                self.bent_images.clear()
+        finally:  # also when cancelled: the scene goes back to its frame
+            scene.frame_set(original)
+        self.finished = True
+
+    def _bake_frame(self, uv_names: dict, start: float, share: float, frame: int | None = None
+                    ) -> Generator[tuple[float, str], None, None]:
+        """Bake every target at the scene's current frame into self.results (and bent_images);
+        progress runs from start over share of the bar."""
+        req = self.request
         depsgraph = self._depsgraph_getter()
         units = [req.targets] if req.texture_set else [[obj] for obj in req.targets]
+        at = "" if frame is None else f" at frame {frame}"
         for k, objects in enumerate(units):
             obj = objects[0]
             label = TEXTURE_SET_NAME if req.texture_set else obj.name
@@ -300,7 +351,8 @@ class BakeJob:
                     except StopIteration as stop:
                         result = stop.value
                         break
-                    yield (k + frac) / len(units), f"Baking AO of '{label}' ({k + 1}/{len(units)}): {frac * 100:.0f}%"
+                    yield (start + share * (k + frac) / len(units),
+                           f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%")
             finally:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
             if settings.bent_normals:
@@ -308,7 +360,6 @@ class BakeJob:
                                                            target, result)
             # A texture set's objects share one result (commit writes it once).
             self.results.extend((o, uv_names[o.name], result) for o in objects)
-        self.finished = True
 
     def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target, result: BakeResult):
         """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
@@ -352,6 +403,9 @@ class BakeJob:
             for obj, _uv, result in self.results:
                 color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
             return self.committed
+        if req.frames:
+            self._commit_frames()
+            return self.committed
         files = self.files  # (label, 'ao' | 'bent') -> the files written, one per UDIM tile
         for obj, label, result in self.baked():
             for kind, path, maps in (("ao", output_path_for(req, obj), result.ao),
@@ -376,6 +430,21 @@ class BakeJob:
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
         return self.committed
+
+    def _commit_frames(self) -> None:
+        """A frame sequence's files: every frame's maps (each UDIM tile its own), in frame
+        order; no image datablocks (a sequence lives in files, as Blender's image sequences)."""
+        req = self.request
+        for entry in self.frame_results:
+            self.results = entry["results"]
+            for obj, label, result in self.baked():
+                for kind, filepath, maps in (("ao", req.filepath, result.ao),
+                                             ("bent", req.bent_filepath, entry["bent_images"].get(label))):
+                    path = output_path_for(req, obj, filepath, entry["frame"])
+                    if path:
+                        written = self._write_maps(path, maps, result.tiles)
+                        self.files.setdefault((label, kind), []).extend(written)
+                        entry.setdefault("outputs", []).extend(written)
 
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""

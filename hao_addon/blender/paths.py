@@ -7,6 +7,9 @@ import bpy
 from ..core.errors import BakeInputError
 
 OBJECT_TOKEN = "{object}"
+# A frame sequence's files: {frame} becomes the frame number, zero-padded like Blender's ####.
+FRAME_TOKEN = "{frame}"
+FRAME_DIGITS = 4
 
 
 def absolute_path(path: str) -> str:

@@ -1,0 +1,96 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Frame sequences (issue 13 item 7): one map per frame of a deforming mesh, {frame} in the
+file names; a frame whose evaluated geometry equals an earlier one reuses its bake; the
+scene's frame comes back afterwards, also when cancelled."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import bpy
+from hao_addon.bake import clear_cache
+from hao_addon.blender.bake_job import BakeJob, BakeRequest
+from hao_addon.core.bake.settings import BakeSettings
+
+ROOT = Path(__file__).resolve().parent.parent
+CESIUM = ROOT / "tests" / "data" / "CesiumMan.glb"
+SETTINGS = BakeSettings(size=128, directions=16, margin=2)
+
+
+def cesium_man():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.gltf(filepath=str(CESIUM))
+    return bpy.data.objects["Cesium_Man"]
+
+
+def run_job(request: BakeRequest) -> BakeJob:
+    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
+    job.run()
+    job.commit()
+    return job
+
+
+def test_each_frame_of_the_walk_equals_a_single_bake_at_that_frame(gpu_context, tmp_path):
+    man = cesium_man()
+    scene = bpy.context.scene
+    scene.frame_set(3)
+    frames = [1, 9, 17]
+    job = run_job(BakeRequest([man], SETTINGS, filepath=str(tmp_path / "man_{frame}.exr"), frames=frames))
+    assert scene.frame_current == 3  # restored
+    assert sorted(os.listdir(tmp_path)) == [f"man_{f:04d}.exr" for f in frames]
+    assert [e["frame"] for e in job.frame_results] == frames and not any(e["reused"] for e in job.frame_results)
+    maps = [e["results"][0][2].ao for e in job.frame_results]
+    assert np.abs(maps[0] - maps[1]).max() > 0.05  # the walk changes the occlusion
+    for frame, baked in zip(frames, maps):
+        clear_cache()  # a fresh bake, not the sequence's cached one
+        scene.frame_set(frame)
+        single = BakeJob(BakeRequest([man], SETTINGS), bpy.context.evaluated_depsgraph_get)
+        single.run()
+        np.testing.assert_array_equal(single.results[0][2].ao, baked)
+
+
+def test_a_static_mesh_over_ten_frames_bakes_once(gpu_context, tmp_path):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.mesh.primitive_monkey_add()
+    clear_cache()
+    job = run_job(BakeRequest([bpy.context.active_object], SETTINGS, filepath=str(tmp_path / "m.png"),
+                              frames=list(range(1, 11))))
+    assert [e["reused"] for e in job.frame_results] == [False] + [True] * 9
+    assert len(os.listdir(tmp_path)) == 10 and (tmp_path / "m_0010.png").is_file()
+    first = (tmp_path / "m_0001.png").read_bytes()
+    assert all((tmp_path / f"m_{f:04d}.png").read_bytes() == first for f in range(2, 11))
+
+
+def test_cancelling_a_sequence_restores_the_frame_and_writes_nothing(gpu_context, tmp_path):
+    man = cesium_man()
+    scene = bpy.context.scene
+    scene.frame_set(4)
+    job = BakeJob(BakeRequest([man], SETTINGS, filepath=str(tmp_path / "{frame}.png"), frames=[1, 2, 3]),
+                  bpy.context.evaluated_depsgraph_get)
+    steps = job.steps()
+    for _ in range(20):  # into the second frame
+        next(steps)
+    assert scene.frame_current != 4
+    steps.close()
+    job.cancel()
+    assert scene.frame_current == 4 and os.listdir(tmp_path) == []
+
+
+def test_cli_frames_and_report(tmp_path):
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp_path)}
+    out = tmp_path / "out"
+    out.mkdir()
+    done = subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(CESIUM), "--frames", "1-9:4", "--size", "64",
+                           "--directions", "8", "--out", str(out / "walk.{frame}.png"), "--json", str(tmp_path / "r.json")],
+                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert sorted(os.listdir(out)) == ["walk.0001.png", "walk.0005.png", "walk.0009.png"]
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert [f["frame"] for f in report["frames"]] == [1, 5, 9] and all(f["seconds"] > 0 for f in report["frames"])
+    assert report["outputs"] == [str(out / f"walk.{f:04d}.png") for f in (1, 5, 9)]
+    assert "x 3 frames (0 reused" in done.stdout
