@@ -74,6 +74,18 @@ def test_batch_names_files_keeps_going_and_reports_each_input(inputs, tmp_path):
     assert not any(i["objects"][0].get("cache_hit") for i in ok)
 
 
+def test_a_batch_of_obj_glb_and_blend_inputs(inputs, tmp_path):
+    """A.obj B.glb C.blend, as pipelines mix them: each input's largest mesh baked."""
+    folder, out = inputs
+    blend = folder / "c.blend"  # a .blend made by the command line itself (the scene of c.obj)
+    made = run([folder / "c.obj", "--target", "color-attribute", "--directions", "4", "--out", blend], tmp_path)
+    assert made.returncode == 0, made.stderr
+    glb = ROOT / "tests" / "data" / "CesiumMan.glb"
+    done = run([folder / "a.obj", glb, blend, "--out-dir", out, "--size", "64", "--directions", "8"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert sorted(os.listdir(out)) == ["CesiumMan_ao.png", "a_ao.png", "c_ao.png"]
+
+
 def test_batch_needs_a_folder_and_distinct_names(inputs, tmp_path):
     folder, out = inputs
     two = [folder / "a.obj", folder / "b.obj"]
