@@ -178,3 +178,20 @@ def test_cli_writes_one_file_per_tile_and_refuses_gltf(tmp_path):
     refused = run("--out", tmp_path / "ao.png", "--gltf-out", tmp_path / "a.glb")
     assert refused.returncode == 2 and "glTF has no UDIM tiles" in refused.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json", "udim.obj"]
+
+
+@pytest.mark.parametrize("method", ["gather", "reference"])
+def test_selected_to_active_onto_udim_tiles(gpu_context, method):
+    """A low-poly of two planes on tiles 1001 and 1002 over a ball on a floor: each tile holds
+    the relief under its plane (the ball's darker than the open floor's), every texel found it."""
+    from hao_addon.bake import HighToLow
+    relief = [scenes.grid_plane(200.0, 16), scenes.uv_sphere(0.5, (0, 0, 0.5))]
+    a, b = scenes.grid_plane(2.0, 2, z=1.2), scenes.grid_plane(2.0, 2, z=1.2)
+    b.positions[..., 0] += 2.0
+    low = TriangleSoup(np.concatenate([a.positions, b.positions]),
+                       np.concatenate([0.01 + 0.98 * a.uvs, 0.01 + 0.98 * b.uvs + [1.0, 0.0]]), "low")
+    res = bake(low, [], BakeSettings(size=32, directions=32, method=method), high_to_low=HighToLow(relief),
+               use_cache=False)
+    assert res.tiles == (1001, 1002) and res.stats["missed_texels"] == 0
+    over_ball, over_floor = (res.ao[k][res.covered[k]].mean() for k in range(2))
+    assert over_ball < 0.9 < 0.97 < over_floor

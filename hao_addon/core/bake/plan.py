@@ -294,8 +294,9 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
         raise BakeInputError(f"'{target.name}': the histogram scatter bakes one UV tile; its UVs lie on UDIM tiles "
                              f"{', '.join(map(str, udim.tiles))}: use the gather (Shadow-Map Gather) or the reference")
     if udim is not None:  # each tile as fine as its own bake would be: the finest of them
-        pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0]
-                         for faces in (np.flatnonzero(udim.face_tile == t) for t in range(udim.count)))
+        tiles = [faces for faces in (np.flatnonzero(udim.face_tile == t) for t in range(udim.count))
+                 if ((areas[faces] > 0.0) & (uv_area[faces] > 0.0)).any()]  # a tile of zero-area faces asks nothing
+        pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
         dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
     elif vertex_target is None:
         pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale,
