@@ -79,7 +79,8 @@ def test_tiled_gather_is_as_accurate_as_its_single_tile_bakes(gpu_context):
     """The gather fits its light views to what it bakes, so tiled and single-tile bakes sample
     different pixel grids; against the reference each tile is at least as accurate as its
     own single-tile bake (each tile's texel density asks for its own light-view resolution
-    and the finest one is used: with the floor's, the balls were 3x worse). Measured: RMSE
+    and the finest one is used: sized by the whole layout, which the floor's coarse texels
+    dominate, the ball's tile differed from its own bake by RMSE 0.051, 0.024 after). Measured: RMSE
     0.141 / 0.008 / 0.115 tiled, 0.152 / 0.015 / 0.117 single (the balls' error is the
     gather's known contact limit at 64^2: texels within 0.003 of the floor)."""
     tiled, singles = single_tile_bakes("gather")
