@@ -37,9 +37,8 @@ from . import util
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .shaders import cached_shader, glsl_source
 
-# Entries per row of the list textures: 4096 rows of 4096 hold a fully covered 4096^2 map
-# within the 16384-texel texture limit; the compute grid is LIST_WIDTH / 64 groups wide.
-LIST_WIDTH = 4096
+# The list textures' row width (util.LIST_WIDTH); the compute grid is LIST_WIDTH / 64 groups wide.
+LIST_WIDTH = util.LIST_WIDTH
 GROUP_SIZE = 64
 ENTRY_BYTES = 16 + 16 + 4  # position + 1/S_f, normal, texel (and 4 bytes per estimator channel)
 LIFT_BYTES = 16  # an entry's terminator lift, where the plan lifts (plan.lifts_terminator)
@@ -318,7 +317,7 @@ class GatherBaker(LightViewBaker):
         them with (the texel of each entry then stays on the CPU: only accumulated() reads it)."""
         size = self.plan.settings.size
         self.entry_count = count
-        rows = max(1, -(-count // LIST_WIDTH))
+        rows = util.list_rows(count)
         if rows > gpu.capabilities.max_texture_size_get():
             raise BakeInputError(f"{count} covered texels exceed this GPU's texture limit; use a smaller map")
         if count > size * size:  # overlapping UV islands or sub-texel samples: more entries than texels
@@ -333,14 +332,9 @@ class GatherBaker(LightViewBaker):
             if self.lifted:
                 self.entry_lift = gpu.types.GPUTexture(shape, format='RGBA32F')
         else:
-            def texture(values: np.ndarray) -> "gpu.types.GPUTexture":
-                full = np.zeros((rows * LIST_WIDTH, 4), np.float32)
-                full[:count] = values
-                return gpu.types.GPUTexture(shape, format='RGBA32F',
-                                            data=gpu.types.Buffer('FLOAT', full.size, full.ravel()))
-            self.entry_position, self.entry_normal = (texture(v) for v in uploaded[:2])
+            self.entry_position, self.entry_normal = (util.list_texture(v, 'RGBA32F') for v in uploaded[:2])
             if len(uploaded) > 2:
-                self.entry_lift = texture(uploaded[2])
+                self.entry_lift = util.list_texture(uploaded[2], 'RGBA32F')
         channels = self.plan.estimator.channel_count
         self.accums = [gpu.types.GPUTexture(shape, format=fmt) for fmt in ACCUM_FORMATS[channels]]
         for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels]):

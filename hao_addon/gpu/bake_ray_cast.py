@@ -20,9 +20,7 @@ from ..core.errors import BakeInputError
 from . import util
 from .shaders import cached_shader, glsl_source
 
-# Values per row of the list textures (rays, triangle corners, cell ranges): 16384 rows of
-# 4096 within the texture limit; the compute grid is LIST_WIDTH / GROUP_SIZE groups wide.
-LIST_WIDTH = 4096
+LIST_WIDTH = util.LIST_WIDTH  # the list textures' rows; the compute grid is LIST_WIDTH / GROUP_SIZE wide
 GROUP_SIZE = 64
 # Rays per dispatch, a progress (and cancel) step: 32 rows, about 0.1 s on llvmpipe.
 RAYS_PER_DISPATCH = 32 * LIST_WIDTH
@@ -56,18 +54,11 @@ def ray_cast_shader() -> "gpu.types.GPUShader":
 
 
 def list_texture(values: np.ndarray, fmt: str) -> "gpu.types.GPUTexture":
-    """A (LIST_WIDTH, rows) texture of `values` ((n, 4) for RGBA32F, (n,) for R32F: float32,
-    or int64 < 2^32 sent as their bits), zero-padded to whole rows."""
-    channels = 4 if fmt == 'RGBA32F' else 1
-    flat = values.astype(np.uint32).view(np.float32) if values.dtype.kind in "iu" else values.astype(np.float32)
-    rows = max(1, -(-len(flat) // LIST_WIDTH))
-    if rows > gpu.capabilities.max_texture_size_get():
-        raise BakeInputError(f"the Selected-to-Active projection needs {len(flat)} list entries, above this "
+    """util.list_texture, refused with one message beyond the GPU's texture size."""
+    if util.list_rows(len(values)) > gpu.capabilities.max_texture_size_get():
+        raise BakeInputError(f"the Selected-to-Active projection needs {len(values)} list entries, above this "
                              f"GPU's texture limit: use a smaller map or fewer high-poly triangles")
-    full = np.zeros((rows * LIST_WIDTH, channels), np.float32)
-    full[:len(flat)] = flat.reshape(len(flat), channels)
-    return gpu.types.GPUTexture((LIST_WIDTH, rows), format=fmt,
-                                data=gpu.types.Buffer('FLOAT', full.size, full.ravel()))
+    return util.list_texture(values, fmt)
 
 
 class GpuRayCast(util.GPUPass):
@@ -87,11 +78,11 @@ class GpuRayCast(util.GPUPass):
         self.ray_origin = list_texture(rays, 'RGBA32F')
         rays[:, :3] = directions
         self.ray_direction = list_texture(rays, 'RGBA32F')
-        self.hit = gpu.types.GPUTexture((LIST_WIDTH, max(1, -(-len(origins) // LIST_WIDTH))), format='RGBA32F')
+        self.hit = gpu.types.GPUTexture((LIST_WIDTH, util.list_rows(len(origins))), format='RGBA32F')
         self.grid, self.ray_count = grid, len(origins)
 
     def dispatch(self, first: int, end: int, reach: float) -> None:
-        """Cast rays first..end (a whole number of rows from `first`)."""
+        """Cast rays first..end (their rows of the list; invocations past end return)."""
         shader = ray_cast_shader()
         shader.bind()
         shader.uniform_int("first_ray", first)
@@ -105,11 +96,12 @@ class GpuRayCast(util.GPUPass):
         gpu.compute.dispatch(shader, LIST_WIDTH // GROUP_SIZE, rows, 1)
         gpu.shader.unbind()
 
-    def hits(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(face (m,) int64, -1 a miss; t (m,) world; uv (m, 2)) of every ray."""
+    def hits(self) -> tuple[np.ndarray, np.ndarray]:
+        """(face (m,) int64, -1 a miss; uv (m, 2) of the hit in that face) of every ray (the
+        shader's t, hit_out.y, is for debugging: the point is the face's at uv)."""
         out = util.texture_to_numpy(self.hit).reshape(-1, 4)[:self.ray_count]
         face = out[:, 0].copy().view(np.int32).astype(np.int64)
-        return face, out[:, 1].astype(np.float64) * self.grid.cell, out[:, 2:].astype(np.float64)
+        return face, out[:, 2:].astype(np.float64)
 
     def _release(self) -> None:
         self.tri_corners = self.cell_start = self.cell_triangles = None
@@ -133,7 +125,7 @@ def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.nda
                 end = min(first + RAYS_PER_DISPATCH, len(origins))
                 cast.dispatch(first, end, reach)
                 yield end / len(origins)
-        face, _t, uv = cast.hits()
+        face, uv = cast.hits()
     finally:
         cast.free()
     bary = np.zeros((len(origins), 3))

@@ -98,6 +98,29 @@ def make_batch(prim: str, attrs: dict[str, tuple[str, np.ndarray]]) -> "gpu.type
     return gpu.types.GPUBatch(type=prim, buf=vbo)
 
 
+# Entries per row of the passes' list textures (texel lists, rays, triangles): 4096 rows of
+# 4096 hold a fully covered 4096^2 map within the 16384-texel texture limit; entry i sits at
+# texel (i % LIST_WIDTH, i // LIST_WIDTH), a define of the same name in the shaders.
+LIST_WIDTH = 4096
+
+
+def list_rows(count: int) -> int:
+    """Rows of a list texture of `count` entries (at least one)."""
+    return max(1, -(-count // LIST_WIDTH))
+
+
+def list_texture(values: np.ndarray, fmt: str) -> "gpu.types.GPUTexture":
+    """A (LIST_WIDTH, rows) texture of `values`, zero-padded to whole rows: (n, 4) for
+    RGBA32F, (n,) for R32F, float32, or integers < 2^32 sent as their bits (only FLOAT buffers
+    upload; shaders read them with floatBitsToUint)."""
+    channels = 4 if fmt == 'RGBA32F' else 1
+    flat = values.astype(np.uint32).view(np.float32) if values.dtype.kind in "iu" else values.astype(np.float32)
+    rows = list_rows(len(flat))
+    full = np.zeros((rows * LIST_WIDTH, channels), np.float32)
+    full[:len(flat)] = flat.reshape(len(flat), channels)
+    return gpu.types.GPUTexture((LIST_WIDTH, rows), format=fmt, data=gpu.types.Buffer('FLOAT', full.size, full.ravel()))
+
+
 def texture_to_numpy(tex: "gpu.types.GPUTexture", dtype=np.float32) -> np.ndarray:
     """Read a 2D texture into a (height, width[, channels]) numpy array (a copy)."""
     buf = tex.read()
