@@ -436,8 +436,7 @@ class BakeJob:
         order; no image datablocks (a sequence lives in files, as Blender's image sequences)."""
         req = self.request
         for entry in self.frame_results:
-            self.results = entry["results"]
-            for obj, label, result in self.baked():
+            for obj, label, result in self.baked(entry["results"]):
                 for kind, filepath, maps in (("ao", req.filepath, result.ao),
                                              ("bent", req.bent_filepath, entry["bent_images"].get(label))):
                     path = output_path_for(req, obj, filepath, entry["frame"])
@@ -450,10 +449,11 @@ class BakeJob:
         """The name a target's outputs carry: its own, or the texture set's."""
         return TEXTURE_SET_NAME if self.request.texture_set else obj.name
 
-    def baked(self) -> list:
-        """(first object, label, result) of each bake (a texture set's objects share one)."""
+    def baked(self, results: list | None = None) -> list:
+        """(first object, label, result) of each bake of results (default self.results, the
+        last frame's in a sequence; a texture set's objects share one result)."""
         seen, out = set(), []
-        for obj, _uv, result in self.results:
+        for obj, _uv, result in self.results if results is None else results:
             if id(result) not in seen:
                 seen.add(id(result))
                 out.append((obj, self.label_of(obj), result))

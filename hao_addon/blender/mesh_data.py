@@ -152,10 +152,7 @@ def color_attribute_target(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph
             tri_loops = tri_loops[:, ::-1]
         loop_vertex = np.empty(len(mesh.loops), np.int64)
         mesh.loops.foreach_get("vertex_index", loop_vertex)
-        target = vertex_target(tri_loops, loop_vertex, domain)
-        if domain == "point":
-            target.count = len(mesh.vertices)  # loose vertices too (they keep the unoccluded 1.0)
-        return target
+        return vertex_target(tri_loops, loop_vertex, domain, len(mesh.vertices))
     finally:
         obj_eval.to_mesh_clear()
 

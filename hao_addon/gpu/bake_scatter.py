@@ -88,8 +88,9 @@ class ScatterBaker(LightViewBaker):
             raise BakeInputError("the histogram scatter cannot bake Selected to Active (it draws the target's own "
                                  "surface); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
         if plan.udim is not None:
-            raise BakeInputError("the histogram scatter bakes one UV tile, not UDIM tiles; use the gather "
-                                 "(Shadow-Map Gather, also Auto's choice) or the reference")
+            raise BakeInputError(f"the histogram scatter bakes one UV tile; these UVs lie on UDIM tiles "
+                                 f"{', '.join(map(str, plan.udim.tiles))}: use the gather (Shadow-Map Gather, also "
+                                 f"Auto's choice) or the reference")
         if plan.vertex_target is not None:
             raise BakeInputError("the histogram scatter cannot bake a colour attribute (it rasterizes the UV "
                                  "layout); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")

@@ -290,11 +290,8 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
 
-    if udim is not None and settings.method_for(high_to_low is not None, tiled=True) == "scatter":
-        raise BakeInputError(f"'{target.name}': the histogram scatter bakes one UV tile; its UVs lie on UDIM tiles "
-                             f"{', '.join(map(str, udim.tiles))}: use the gather (Shadow-Map Gather) or the reference")
     if udim is not None:  # each tile as fine as its own bake would be: the finest of them
-        tiles = [faces for faces in (np.flatnonzero(udim.face_tile == t) for t in range(udim.count))
+        tiles = [faces for faces in map(udim.faces, range(udim.count))
                  if ((areas[faces] > 0.0) & (uv_area[faces] > 0.0)).any()]  # a tile of zero-area faces asks nothing
         pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
         dense_fraction = 0.0  # the scatter's split, and it bakes no tiles

@@ -35,9 +35,13 @@ class UdimLayout:
     def count(self) -> int:
         return len(self.tiles)
 
+    def faces(self, tile: int) -> np.ndarray:
+        """(k,) int64 the triangles of tile index `tile`."""
+        return np.flatnonzero(self.face_tile == tile)
+
     def local_uvs(self, uvs: np.ndarray, tile: int) -> tuple[np.ndarray, np.ndarray]:
         """(faces (k,) int64 of tile index `tile`, their UVs (k, 3, 2) moved into 0..1)."""
-        faces = np.flatnonzero(self.face_tile == tile)
+        faces = self.faces(tile)
         return faces, uvs[faces] - self.offsets[tile]
 
 

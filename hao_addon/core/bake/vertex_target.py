@@ -33,17 +33,22 @@ class VertexTarget:
     domain: str = "point"
 
 
-def vertex_target(tri_loops: np.ndarray, loop_vertex: np.ndarray, domain: str) -> VertexTarget:
+def vertex_target(tri_loops: np.ndarray, loop_vertex: np.ndarray, domain: str,
+                  vertex_count: int | None = None) -> VertexTarget:
     """The target of triangles whose corners are the face corners tri_loops (F, 3) int64 of a
-    mesh whose corner l lies on vertex loop_vertex[l] (L,); domain 'point' or 'corner'.
-    The first triangle that holds a face corner samples it (Blender's order)."""
+    mesh of vertex_count vertices (default: the highest one used, + 1; loose vertices count
+    too, keeping the unoccluded 1.0) whose corner l lies on vertex loop_vertex[l] (L,);
+    domain 'point' or 'corner'. The first triangle that holds a face corner samples it
+    (Blender's order)."""
     if domain not in DOMAINS:
         raise ValueError(f"unknown colour-attribute domain '{domain}', expected one of {DOMAINS}")
     flat = np.asarray(tri_loops, np.int64).ravel()
     first = np.zeros(len(flat), bool)
     first[np.unique(flat, return_index=True)[1]] = True
     cells = np.where(first, flat if domain == "corner" else np.asarray(loop_vertex, np.int64)[flat], -1)
-    count = len(loop_vertex) if domain == "corner" else int(loop_vertex.max(initial=-1)) + 1
+    if vertex_count is None:
+        vertex_count = int(np.max(loop_vertex, initial=-1)) + 1
+    count = len(loop_vertex) if domain == "corner" else int(vertex_count)
     return VertexTarget(cells.reshape(-1, 3), count, domain)
 
 
