@@ -334,8 +334,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 
     from .blender.bake_job import BakeJob, BakeRequest, output_path_for
     from .blender.color_attributes import AO_ATTRIBUTE
-    from .blender.paths import OBJECT_TOKEN
-    from .core.bake.udim import UDIM_TOKEN
+    from .blender.paths import example_path, frame_pattern
     from .core.imageio import check_writable
     from .core.bake.settings import BakeSettings
 
@@ -350,7 +349,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                        "(.blend, .glb or .ply); --bent-normal-out and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
-        check_writable(args.bent_normal_out.replace(OBJECT_TOKEN, "object"), settings.size, settings.size, 4,
+        check_writable(example_path(args.bent_normal_out), settings.size, settings.size, 4,
                        source=source)
     gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
@@ -358,8 +357,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     # Refused before a long load; checked again with the object's name once it is known.
     mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
     if not to_colors:
-        check_writable(args.out.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, "1001").replace("{frame}", "0000"),
-                       settings.size, settings.size, 1, source=source)
+        check_writable(example_path(args.out), settings.size, settings.size, 1, source=source)
     check_json_target(args.json)
     with report.phase("load"):
         progress.update("loading")
@@ -436,24 +434,24 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         st = result.stats
         tile_files = job.files.get((label, "ao"), [])
         several = len(tile_files) > 1 or request.frames  # UDIM tiles or frames: every file
-        out = str(mesh_out) if to_colors else (", ".join(tile_files) if several else output_path_for(request, obj))
-        report.outputs.extend(tile_files if several else [out])
+        report.outputs.extend(tile_files if several else [output_path_for(request, obj)])
         report.outputs.extend(job.files.get((label, "bent"), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
                  f"'{AO_ATTRIBUTE}')" if to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
+        frames, dest = "", str(mesh_out) if to_colors else ", ".join(tile_files) or output_path_for(request, obj)
+        if request.frames:
+            reused = sum(e["reused"] for e in job.frame_results)
+            frames = f" x {len(request.frames)} frames ({reused} reused, same geometry)"
+            dest = frame_pattern(output_path_for(request, obj))
         lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {settings.directions} "
-                     f"directions in {time.perf_counter() - t0:.2f} s -> {out}")
+                     f"directions{frames} in {time.perf_counter() - t0:.2f} s -> {dest}")
     if gltf_out is not None:
         report.outputs.append(str(gltf_out))
     if request.frames:
         report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"],
                               outputs=e.get("outputs", [])) for e in job.frame_results]
-        reused = sum(e["reused"] for e in job.frame_results)
-        lines = [line.split(" -> ")[0] + f" x {len(request.frames)} frames ({reused} reused, same geometry) -> "
-                 + output_path_for(request, obj).replace("{frame}", "####") for line, (obj, _l, _r)
-                 in zip(lines, job.baked())]
     return lines
 
 

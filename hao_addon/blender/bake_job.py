@@ -23,11 +23,11 @@ from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
 from ..core.bake.texture_set import texture_set_target
-from ..core.bake.udim import UDIM_TOKEN, tile_path, udim_layout
+from ..core.bake.udim import tile_path, udim_layout
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
-from .paths import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN, absolute_path, object_file_name
+from .paths import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
@@ -164,8 +164,7 @@ def validate_request(request: BakeRequest) -> None:
                                      f"the AO map and the bent normals of '{obj.name}' would both be saved as "
                                      f"'{path}'")
             writers[path] = obj.name
-            check_writable(path.replace(UDIM_TOKEN, "1001").replace(FRAME_TOKEN, "0" * FRAME_DIGITS), size, size,
-                           channels, source=request.source_path or None)
+            check_writable(example_path(path), size, size, channels, source=request.source_path or None)
 
 
 def _validate_frames(request: BakeRequest) -> None:

@@ -12,6 +12,19 @@ FRAME_TOKEN = "{frame}"
 FRAME_DIGITS = 4
 
 
+def example_path(path: str) -> str:
+    """The path with every token filled by an example value ('{object}' -> 'object', <UDIM> ->
+    1001, '{frame}' -> 0000), for checking before a bake that such a file can be written."""
+    from ..core.bake.udim import FIRST_TILE, UDIM_TOKEN
+    return (path.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, str(FIRST_TILE))
+            .replace(FRAME_TOKEN, "0" * FRAME_DIGITS))
+
+
+def frame_pattern(path: str) -> str:
+    """A sequence's path as Blender shows one: '{frame}' as '####' (FRAME_DIGITS of them)."""
+    return path.replace(FRAME_TOKEN, "#" * FRAME_DIGITS)
+
+
 def absolute_path(path: str) -> str:
     """Blender's abspath, refusing '//' paths while the .blend file has no location (they would
     silently land in the process's working directory)."""
