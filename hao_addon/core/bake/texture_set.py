@@ -23,19 +23,18 @@ def cross_object_overlaps(parts: list[TriangleSoup], size: int) -> list[tuple[st
     islands cover the same texel centres beyond OVERLAP_TOLERANCE (at min(size, CHECK_SIDE)),
     UDIM tiles included (texels of different tiles never overlap)."""
     side = min(int(size), CHECK_SIDE)
-    covers = []
+    covers = []  # per part: the sorted keys of the texel centres it covers, (tile, texel) in one int64
     for part in parts:
         tiles = np.floor(part.uvs.mean(axis=1)).astype(np.int64)
-        cells = set()
+        keys = []
         for tile in np.unique(tiles, axis=0):
-            faces = (tiles == tile).all(axis=1)
-            hit = np.flatnonzero(texel_centre_hits(part.uvs[faces] - tile, side).ravel() > 0)
-            cells.update((int(tile[0]), int(tile[1]), int(c)) for c in hit)
-        covers.append(cells)
+            hit = np.flatnonzero(texel_centre_hits(part.uvs[(tiles == tile).all(axis=1)] - tile, side).ravel() > 0)
+            keys.append(((tile[0] * 100_003 + tile[1]) * side * side) + hit)
+        covers.append(np.unique(np.concatenate(keys)))
     found = []
     for a in range(len(parts)):
         for b in range(a + 1, len(parts)):
-            shared = len(covers[a] & covers[b])
+            shared = len(np.intersect1d(covers[a], covers[b], assume_unique=True))
             smaller = max(1, min(len(covers[a]), len(covers[b])))
             if shared > OVERLAP_TOLERANCE * smaller:
                 found.append((parts[a].name, parts[b].name, shared / smaller))
