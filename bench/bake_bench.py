@@ -43,7 +43,7 @@ from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
-from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
+from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tools"))
 from cycles_bake import cycles_ao_bake  # noqa: E402

@@ -36,7 +36,7 @@ from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
 from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
-from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
+from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600
 TABLE1 = ViewAOSettings(rays=32, steps=8, grid=256, scale=2, filter_size=16)
@@ -80,7 +80,7 @@ def timed_frame(renderer, objects, view_proj, settings) -> dict:
     from hao_addon.gpu.hao_composite import draw_composite
 
     r = renderer
-    r._keys.clear()
+    r.invalidate()
     out = {}
     t = time.perf_counter()
     r.render(objects, view_proj, WIDTH, HEIGHT, settings)  # keys cleared: uploads once, then all passes
@@ -167,7 +167,7 @@ def workbench_seconds(soups: list[TriangleSoup], repeats: int) -> float:
 
 
 def error_against_reference(renderer, soups, settings, picks, bvh, rays) -> float:
-    renderer._keys.clear()
+    renderer.invalidate()
     _, _, vp = camera()
     renderer.render(objects_of(soups), vp, WIDTH, HEIGHT, settings)
     ao = renderer.read_ao()
@@ -187,7 +187,7 @@ def objects_of(soups):
 
 
 def reference_picks(renderer, soups, settings, count, rays, seed=3):
-    renderer._keys.clear()
+    renderer.invalidate()
     _, _, vp = camera()
     renderer.render(objects_of(soups), vp, WIDTH, HEIGHT, settings)
     pos, nrm, _ = renderer.gbuffer.read()

@@ -38,7 +38,7 @@ from hao_addon.core.proxies.lloyd import lloyd_clusters, sphere_proxies, vertex_
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
 from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
-from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
+from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600
 METHODS = ("hao", "near", "far", "near+far", "hao+far")
@@ -120,7 +120,7 @@ def finish(tex):
 def frame_passes(renderer, objects, vp, spheres, repeats):
     """Time HAO's AO sampling and the far pass with the given spheres on one frame (ms)."""
     table1 = ViewAOSettings(rays=32, steps=8, grid=256, scale=2, filter_size=16, max_distance=0.3)
-    renderer._keys.clear()
+    renderer.invalidate()
     renderer.render(objects, vp, WIDTH, HEIGHT, table1)
 
     def ao():
@@ -168,7 +168,7 @@ def character_scene(frame, k):
 def method_errors(renderer, objects, spheres, vp, methods, points, rays, seed, receivers=None, max_distance=0.3):
     rows = {}
     settings0 = ViewAOSettings(max_distance=max_distance, grid=256)
-    renderer._keys.clear()
+    renderer.invalidate()
     renderer.render(objects, vp, WIDTH, HEIGHT, settings0.with_(method="hao"))
     pos, nrm, _ = renderer.gbuffer.read()
     mask = pos[..., 3] >= 1.0
@@ -184,15 +184,11 @@ def method_errors(renderer, objects, spheres, vp, methods, points, rays, seed, r
                                   bvh=build_bvh(tris))
     for method in methods:
         s = settings0.with_(method=method)
-        renderer._keys.clear()
+        renderer.invalidate()
         renderer.render(objects, vp, WIDTH, HEIGHT, s, spheres=spheres)  # warm (uploads)
         times = []
         for _ in range(3):
-            renderer._keys.pop("ao", None)
-            renderer._keys.pop("filter", None)
-            renderer._keys.pop("grid", None)
-            renderer._keys.pop("view", None)
-            renderer._keys.pop("back", None)
+            renderer.invalidate(keep=("upload",))
             t = time.perf_counter()
             renderer.render(objects, vp, WIDTH, HEIGHT, s, spheres=spheres)
             ao = renderer.read_ao()

@@ -510,7 +510,7 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
 def start_gpu() -> None:
     """Blender's GPU context, made while signals wait (an interrupt inside its creation, which
     runs Python callbacks from C, is not safe)."""
-    from .gpu.context import ensure_gpu_context
+    from .blender.gpu_context import ensure_gpu_context
     with deferred_signals():
         ensure_gpu_context()
 
@@ -642,7 +642,7 @@ def _failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
     if isinstance(exc, CLIError):
         return exc.code, str(exc)
     try:
-        from .gpu.context import GPUUnavailableError
+        from .blender.gpu_context import GPUUnavailableError
     except ImportError:  # no bpy at all
         GPUUnavailableError = ()  # noqa: N806
     if GPUUnavailableError and isinstance(exc, GPUUnavailableError):

@@ -9,6 +9,7 @@ import numpy as np
 from .blender.sphere_proxies import scene_spheres
 from .blender.view_scene import camera_view_projection, visible_scene_objects
 from .core.errors import BakeInputError
+from .core.hao.methods import method_plan
 from .core.hao.view_settings import RenderSize, ViewAOSettings, render_gpu_bytes
 
 
@@ -18,7 +19,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     """(H, W, 4) float32 RGBA, row 0 at the bottom: accessibility in RGB (1 = open), alpha 1
     on geometry and 0 on background (whose RGB is 1). `renderer`: a HaoRenderer to reuse
     (its skips then apply across calls); by default a temporary one."""
-    from .gpu.context import ensure_gpu_context
+    from .blender.gpu_context import ensure_gpu_context
     from .gpu.hao_renderer import HaoRenderer
     from .gpu.util import check_render_limits, texture_to_numpy
 
@@ -33,7 +34,8 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)
     if not objects:
         raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects")
-    spheres, proxied = scene_spheres(view_layer, depsgraph) if settings.method != "hao" else (None, set())
+    spheres, proxied = (scene_spheres(view_layer, depsgraph) if method_plan(settings.method).spheres
+                        else (None, set()))
     for obj in objects:
         obj.proxied = obj.name in proxied
     view_proj = camera_view_projection(camera, depsgraph, width, height)

@@ -10,7 +10,7 @@ import bpy
 from ..hao_addon.blender.bake_job import BakeJob
 from ..hao_addon.blender.color_attributes import AO_ATTRIBUTE
 from ..hao_addon.core.errors import BakeInputError
-from ..hao_addon.gpu.context import GPUUnavailableError
+from ..hao_addon.blender.gpu_context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
 
 # Errors a user can act on: reported, never raised into Blender's console.

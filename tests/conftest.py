@@ -38,7 +38,7 @@ def pytest_unconfigure(config):
 
 @pytest.fixture(scope="session")
 def gpu_context():
-    from hao_addon.gpu.context import ensure_gpu_context
+    from hao_addon.blender.gpu_context import ensure_gpu_context
     ensure_gpu_context()
     return True
 

@@ -202,7 +202,7 @@ def test_render_operator_and_overlay_registration(addon, gpu_context, tmp_path):
     assert viewport_overlay._draw_handle is not None
     scene.hao_view.enabled = True
     viewport_overlay.draw_overlay()
-    assert not viewport_overlay._renderers
+    assert not viewport_overlay._session.renderers
     scene.camera = None
     assert not bpy.ops.render.hao_render_ao.poll()
 

@@ -22,7 +22,7 @@ from .mesh_data import read_positions
 
 BAKED_AO_PROPERTY = "hao_ao_image"  # set on objects by the Bake AO operator
 
-_CACHE: dict[str, tuple[object, SceneObject]] = {}
+_DEFAULT_CACHE: dict[str, tuple[object, SceneObject]] = {}
 
 
 def _key(obj_eval, mesh) -> str:
@@ -57,10 +57,13 @@ def _build(obj_eval, mesh, key: str) -> SceneObject:
 
 
 def visible_scene_objects(depsgraph: bpy.types.Depsgraph, view_layer: bpy.types.ViewLayer,
-                          skip_baked: bool = False, only: set[str] | None = None) -> list[SceneObject]:
+                          skip_baked: bool = False, only: set[str] | None = None,
+                          cache: dict | None = None) -> list[SceneObject]:
     """Every visible mesh object of the view layer (or those named in `only`) as SceneObjects.
     skip_baked: objects carrying a baked AO map (BAKED_AO_PROPERTY) are drawn and occlude
-    but get no HAO."""
+    but get no HAO. cache: object name -> (key, SceneObject) of earlier looks (a viewport
+    session's own; by default this module's)."""
+    store = _DEFAULT_CACHE if cache is None else cache
     out = []
     seen = set()
     for obj in view_layer.objects:
@@ -72,10 +75,10 @@ def visible_scene_objects(depsgraph: bpy.types.Depsgraph, view_layer: bpy.types.
         mesh = obj_eval.to_mesh()
         try:
             key = _key(obj_eval, mesh)
-            cached = _CACHE.get(obj.name)
+            cached = store.get(obj.name)
             if cached is None or cached[0] != key:
                 cached = (key, _build(obj_eval, mesh, key))
-                _CACHE[obj.name] = cached
+                store[obj.name] = cached
         finally:
             obj_eval.to_mesh_clear()
         so = cached[1]
@@ -83,14 +86,14 @@ def visible_scene_objects(depsgraph: bpy.types.Depsgraph, view_layer: bpy.types.
         seen.add(obj.name)
         if len(so.positions):
             out.append(so)
-    for name in list(_CACHE):
+    for name in list(store):
         if name not in seen and only is None:
-            del _CACHE[name]
+            del store[name]
     return out
 
 
 def clear_cache() -> None:
-    _CACHE.clear()
+    _DEFAULT_CACHE.clear()
 
 
 def camera_view_projection(camera: bpy.types.Object, depsgraph: bpy.types.Depsgraph,

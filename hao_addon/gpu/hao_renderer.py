@@ -1,8 +1,12 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Hybrid Ambient Occlusion frame: voxelize -> G-buffer -> AO sampling -> bilateral upsample.
-One code path for the viewport overlay and the headless render (hao_addon/render_ao.py).
+"""Hybrid Ambient Occlusion frame: one small sequencer runs a method's passes
+(core/hao/methods.py) over the frame's inputs. One code path for the viewport overlay and the
+headless render (hao_addon/render_ao.py).
 
-Skips (counted in `stats`, shown by tests/test_hao_skip.py):
+Each pass is a row of PASSES: what it reads (frame inputs and resources other passes wrote),
+the settings it depends on, the resource it writes. Its key is made of those; it runs only
+when the resource it writes does not already hold that key, so the skips are (counted in
+`stats`, shown by tests/test_hao_skip.py):
 - geometry upload only when an object's key (geometry or transform) or the set of objects
   changed; voxelization only when that happened to an object reaching into the region of
   interest, or the region or the grid resolution changed;
@@ -11,15 +15,19 @@ Skips (counted in `stats`, shown by tests/test_hao_skip.py):
 - filtering only when the AO or a filter setting changed;
 - inside the AO pass, background pixels, objects with a baked AO map and points outside the
   region of interest are not marched (`sampled_pixels` counts those that are).
+The AO map is one resource written in place by a chain of passes (voxel_ao then spheres,
+say): a pass that starts it runs again whenever another pass changed it since.
 """
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import dataclass
 
 import gpu
 import numpy as np
 
 from ..core.errors import BakeInputError
+from ..core.hao.methods import MethodPlan, method_plan
 from ..core.hao.view_scene import SceneObject, render_anchor, scene_bounds
 from ..core.hao.view_settings import ViewAOSettings
 from ..core.hao.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
@@ -30,10 +38,52 @@ from .hao_voxelize import VoxelPass
 from .near_field import run_near_field
 from .sphere_far import FarSpheresPass
 
+AO_MAP = "ao_map"  # the low-resolution AO map, written in place by a method's AO passes
+
+
+@dataclass(frozen=True)
+class PassSpec:
+    """reads: frame inputs (geometry, grid, view, spheres) and resources (a pass name, or
+    AO_MAP) whose keys its key includes; settings: ViewAOSettings fields it depends on;
+    writes: the resource it leaves (its own name, or AO_MAP); stat: its counter in stats."""
+    reads: tuple[str, ...]
+    settings: tuple[str, ...]
+    stat: str
+    writes: str = ""
+
+
+PASSES = {
+    "upload": PassSpec(("geometry",), (), "upload"),
+    # Not the upload: the grid's key names the objects reaching into it (one changing outside
+    # a user region is uploaded again, not voxelized again).
+    "voxelize": PassSpec(("grid",), (), "voxelize"),
+    "gbuffer": PassSpec(("upload", "view"), (), "gbuffer"),
+    "back_layer": PassSpec(("upload", "view"), (), "back_layer"),
+    "low_gbuffer": PassSpec(("gbuffer",), ("scale",), "low_gbuffer"),
+    "voxel_ao": PassSpec(("gbuffer", "voxelize"), ("scale", "rays", "steps", "spread", "max_distance"), "ao",
+                         AO_MAP),
+    "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance"), "near", AO_MAP),
+    "open_ao": PassSpec(("gbuffer",), ("scale",), "open_ao", AO_MAP),
+    "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres"), ("epsilon",), "far", AO_MAP),
+    "filter": PassSpec((AO_MAP,), ("filter_size", "max_distance"), "filter"),
+}
+
 
 def _boxes_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
     """Whether the boxes [lo_a, hi_a] and [lo, hi] overlap."""
     return bool((lo_a <= hi).all() and (hi_a >= lo).all())
+
+
+@dataclass
+class Frame:
+    """One render call's inputs, anchor-relative (see render_anchor)."""
+    objects: list[SceneObject]
+    voxelized: list[SceneObject]
+    view_proj: np.ndarray  # (4, 4) anchor-relative -> clip
+    width: int
+    height: int
+    settings: ViewAOSettings
+    spheres: tuple[np.ndarray, np.ndarray] | None
 
 
 class HaoRenderer(util.GPUPass):
@@ -47,45 +97,49 @@ class HaoRenderer(util.GPUPass):
         self.back = GBufferPass(back_layer=True)  # second layer of the near-field pass
         self.low_gbuffer = LowGBufferPass()  # G-buffer at the AO-map resolution, for the spheres
         self.stats: Counter = Counter()
-        self._keys: dict[str, object] = {}
+        self._state: dict[str, object] = {}  # resource -> key of what it holds now
+        self._boxes_key: object = None
+        self._boxes: list = []
         self.spec: GridSpec | None = None
         self.anchor = np.zeros(3)  # world point the GPU passes' positions are relative to
-        self._boxes: list = []
-
-    def _changed(self, name: str, key: object) -> bool:
-        if self._keys.get(name) == key:
-            return False
-        self._keys[name] = key
-        return True
 
     def render(self, objects: list[SceneObject], view_proj: np.ndarray, width: int, height: int,
                settings: ViewAOSettings, region: tuple[np.ndarray, np.ndarray] | None = None,
                spheres: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Run what changed since the last call. view_proj: (4, 4) world -> clip;
         region: world box (lo, hi) of the region of interest, default the objects' bounds;
-        spheres: (centres (K, 3), radii (K,)) sphere proxies for the 'far' methods.
+        spheres: (centres (K, 3), radii (K,)) sphere proxies for the methods that use them.
         On an error no compute shader stays bound (draw passes restore their own state)."""
         try:
-            self._render(objects, view_proj, width, height, settings, region, spheres)
+            self._render(objects, view_proj, width, height, settings.validated(), region, spheres)
         except BaseException:
             gpu.shader.unbind()
-            self._keys.clear()  # a pass may have stopped half way: redo everything next time
+            self._state.clear()  # a pass may have stopped half way: redo everything next time
             raise
 
+    def invalidate(self, keep: tuple[str, ...] = ()) -> None:
+        """Forget what the resources hold, except those named in keep (pass names): the next
+        render runs every other pass of its method (benchmarks time whole frames so)."""
+        self._state = {k: v for k, v in self._state.items() if k in keep}
+
     def _render(self, objects, view_proj, width, height, settings, region, spheres) -> None:
-        settings = settings.validated()
         if width < 1 or height < 1:
             raise BakeInputError(f"image size must be positive, got {width}x{height}")
+        plan = method_plan(settings.method)
+        if plan.spheres and spheres is None:
+            raise BakeInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
         self.stats["frames"] += 1
-        # With 'hao+far' the spheres stand in for the objects that have them: those are drawn
-        # and receive AO but are not voxelized, so no occluder is counted twice.
-        voxelized = [o for o in objects if not (settings.method == "hao+far" and o.proxied)]
+        inputs, frame = self._frame_inputs(plan, objects, view_proj, width, height, settings, region, spheres)
+        self._sequence(plan, inputs, frame)
+
+    def _frame_inputs(self, plan: MethodPlan, objects, view_proj, width, height, settings, region, spheres):
+        """(the frame inputs' keys, the Frame): geometry, grid, view and spheres."""
+        voxelized = [o for o in objects if not (plan.voxels == "unproxied" and o.proxied)]
         geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
-        # Object boxes are a pass over every triangle: only when an object changed.
-        if self._changed("boxes", geometry_key):
+        if self._boxes_key != geometry_key:  # object boxes are a pass over every triangle
             self._boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
-        boxes = self._boxes
-        world_bounds = scene_bounds(objects, boxes)
+            self._boxes_key = geometry_key
+        world_bounds = scene_bounds(objects, self._boxes)
         bounds = region if region is not None else world_bounds
         if bounds is None:
             raise BakeInputError("nothing to render: no visible mesh objects")
@@ -93,77 +147,93 @@ class HaoRenderer(util.GPUPass):
         # origin); G-buffer positions read back are relative to it (self.anchor).
         anchor = render_anchor(*(world_bounds if world_bounds is not None else bounds))
         self.anchor = anchor
+        self.spec = grid_for_bounds(np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor, settings.grid)
+        # Only objects reaching into the region can change the grid: one moving outside a
+        # user region re-renders the G-buffer but is not re-voxelized.
+        lo = np.asarray(self.spec.origin) + anchor
+        hi = lo + np.asarray(self.spec.dims) * self.spec.voxel
+        inside = tuple(k for o, k, box in zip(objects, geometry_key, self._boxes)
+                       if box is not None and o in voxelized and _boxes_overlap(*box, lo, hi))
+        shift = np.identity(4)
+        shift[:3, 3] = anchor
+        view_proj = np.asarray(view_proj, np.float64) @ shift  # anchor-relative -> clip
+        if spheres is not None:
+            spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
+        inputs = {
+            "geometry": (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes()),
+            "grid": (inside, self.spec, anchor.tobytes()),
+            "view": (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height),
+            "spheres": ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes())
+                        if spheres is not None else None),
+        }
+        return inputs, Frame(objects, voxelized, view_proj, width, height, settings, spheres)
+
+    def _sequence(self, plan: MethodPlan, inputs: dict, frame: Frame) -> None:
+        """Run the plan's passes whose resource does not hold their key yet."""
+        keys = dict(inputs)
+        for name in plan.passes:
+            spec = PASSES[name]
+            key = (name, tuple(keys.get(r) for r in spec.reads),
+                   tuple(getattr(frame.settings, f) for f in spec.settings))
+            resource = spec.writes or name
+            if self._state.get(resource) != key:
+                getattr(self, "_run_" + name)(frame)
+                self._state[resource] = key
+                self.stats[spec.stat] += 1
+            keys[resource] = key
+
+    # The passes (PASSES): each runs unconditionally; the sequencer decides when.
+
+    def _run_upload(self, frame: Frame) -> None:
+        anchor = self.anchor
 
         def relative(objs):
             if not objs:
                 return np.zeros((0, 3, 3), np.float32)
             return np.concatenate([(o.positions + (o.offset - anchor)).astype(np.float32) for o in objs])
 
-        if self._changed("geometry", (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes())):
-            pos = relative(objects)
-            nrm = (np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32))
-            flags = np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects]) \
-                if objects else np.zeros(0, np.float32)
-            vpos = relative(voxelized)
-            solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
-                     else np.zeros(0, bool))
-            self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
-            self.gbuffer.set_geometry(pos, nrm, flags)
-            self.back.set_geometry(pos, nrm, flags)
-            self.stats["upload"] += 1
-        self.spec = grid_for_bounds(np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor, settings.grid)
-        # Only objects reaching into the region can change the grid: one moving outside a
-        # user region re-renders the G-buffer but is not re-voxelized.
-        lo = np.asarray(self.spec.origin) + anchor
-        hi = lo + np.asarray(self.spec.dims) * self.spec.voxel
-        inside = tuple(k for o, k, box in zip(objects, geometry_key, boxes)
-                       if box is not None and o in voxelized and _boxes_overlap(*box, lo, hi))
-        grid_key = (inside, self.spec, anchor.tobytes())
-        use_voxels = settings.method in ("hao", "hao+far")
-        if use_voxels and self._changed("grid", grid_key):
-            self.voxels.voxelize(self.spec)
-            self.stats["voxelize"] += 1
-        shift = np.identity(4)
-        shift[:3, 3] = anchor
-        view_proj = np.asarray(view_proj, np.float64) @ shift  # anchor-relative -> clip
-        if spheres is not None:
-            spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
-        view_key = (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height)
-        if self._changed("view", view_key):
-            self.gbuffer.render(view_proj, width, height)
-            self.stats["gbuffer"] += 1
-        use_near = settings.method in ("near", "near+far")
-        if use_near and self._changed("back", view_key):
-            self.back.render(view_proj, width, height)
-            self.stats["back_layer"] += 1
-        use_spheres = settings.method in ("far", "hao+far", "near+far")
-        if use_spheres and spheres is None:
-            raise BakeInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
-        sphere_key = ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes(),
-                       settings.epsilon) if use_spheres else None)
-        ao_key = (settings.method, grid_key if use_voxels else None, view_key, sphere_key, settings.scale,
-                  (settings.rays, settings.steps, settings.spread, settings.max_distance) if use_voxels or use_near
-                  else None)
-        if self._changed("ao", ao_key):
-            if use_voxels:
-                self.sampling.run(self.gbuffer, self.voxels, settings)
-                self.stats["ao"] += 1
-            elif use_near:
-                self.sampling.clear(self.gbuffer, settings.scale)
-                run_near_field(self.gbuffer, self.back, self.sampling.ao_low, settings.scale, view_proj,
-                               settings.max_distance, settings.rays)
-                self.stats["near"] += 1
-            else:
-                self.sampling.clear(self.gbuffer, settings.scale)
-            if use_spheres:
-                if self._changed("low_gbuffer", (view_key, settings.scale)):
-                    self.low_gbuffer.run(self.gbuffer, settings.scale)
-                self.far.run(self.low_gbuffer, self.sampling.ao_low, spheres[0], spheres[1], settings.epsilon,
-                             view_proj)
-                self.stats["far"] += 1
-        if self._changed("filter", (ao_key, settings.filter_size)):
-            self.filter.run(self.gbuffer, self.sampling.ao_low, settings)
-            self.stats["filter"] += 1
+        objects, voxelized = frame.objects, frame.voxelized
+        pos = relative(objects)
+        nrm = np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32)
+        flags = (np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects])
+                 if objects else np.zeros(0, np.float32))
+        vpos = relative(voxelized)
+        solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
+                 else np.zeros(0, bool))
+        self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
+        self.gbuffer.set_geometry(pos, nrm, flags)
+        self.back.set_geometry(pos, nrm, flags)
+
+    def _run_voxelize(self, frame: Frame) -> None:
+        self.voxels.voxelize(self.spec)
+
+    def _run_gbuffer(self, frame: Frame) -> None:
+        self.gbuffer.render(frame.view_proj, frame.width, frame.height)
+
+    def _run_back_layer(self, frame: Frame) -> None:
+        self.back.render(frame.view_proj, frame.width, frame.height)
+
+    def _run_low_gbuffer(self, frame: Frame) -> None:
+        self.low_gbuffer.run(self.gbuffer, frame.settings.scale)
+
+    def _run_voxel_ao(self, frame: Frame) -> None:
+        self.sampling.run(self.gbuffer, self.voxels, frame.settings)
+
+    def _run_near_field(self, frame: Frame) -> None:
+        settings = frame.settings
+        self.sampling.clear(self.gbuffer, settings.scale)
+        run_near_field(self.gbuffer, self.back, self.sampling.ao_low, settings.scale, frame.view_proj,
+                       settings.max_distance, settings.rays)
+
+    def _run_open_ao(self, frame: Frame) -> None:
+        self.sampling.clear(self.gbuffer, frame.settings.scale)
+
+    def _run_spheres(self, frame: Frame) -> None:
+        centres, radii = frame.spheres
+        self.far.run(self.low_gbuffer, self.sampling.ao_low, centres, radii, frame.settings.epsilon, frame.view_proj)
+
+    def _run_filter(self, frame: Frame) -> None:
+        self.filter.run(self.gbuffer, self.sampling.ao_low, frame.settings)
 
     @property
     def ao_texture(self) -> "gpu.types.GPUTexture":
@@ -180,4 +250,4 @@ class HaoRenderer(util.GPUPass):
     def _release(self) -> None:
         for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far, self.back, self.low_gbuffer):
             p.free()
-        self._keys.clear()
+        self._state.clear()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from .methods import method_plan
 from ..setting_spec import Choice, setting, validate
 
 GRID_MIN, GRID_MAX = 64, 512
@@ -71,7 +72,7 @@ GBUFFER_LAYER_BYTES, FILTER_BYTES, BYTES_PER_AO_PIXEL = 36, 8, 40
 def render_gpu_bytes(width: int, height: int, settings: ViewAOSettings) -> int:
     """Estimate of the GPU memory a width x height frame takes (images and voxel grid)."""
     low = -(-width // settings.scale) * -(-height // settings.scale)
-    layers = 2 if "near" in settings.method else 1
+    layers = 2 if "back_layer" in method_plan(settings.method).passes else 1
     full = width * height * (layers * GBUFFER_LAYER_BYTES + FILTER_BYTES)
     return full + low * BYTES_PER_AO_PIXEL + settings.grid ** 3 // 8
 

@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The viewport AO methods as data (pure Python): the passes each one runs, in order, and
+what its voxels hold. The GPU renderer (hao_addon/gpu/hao_renderer.py) knows how to run each
+pass and what each one reads; a method is nothing but this list, so a new method, or a new
+way to combine two, is a new row here and at most a new pass there.
+
+Pass names (what each computes is documented with its runner in the renderer):
+upload, voxelize, gbuffer, back_layer, low_gbuffer: scene buffers;
+voxel_ao, near_field, open_ao: start the AO map (voxel march, image-space near field, all 1);
+spheres: multiply the sphere proxies' occlusion into it; filter: bilateral upsampling.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class MethodPlan:
+    """passes: run in this order; voxels: which objects the voxel grid holds ('all', or
+    'unproxied': those without sphere proxies, which the spheres stand in for); spheres:
+    whether the method needs sphere proxies."""
+    name: str
+    passes: tuple[str, ...]
+    voxels: str = "all"
+    spheres: bool = False
+
+    @property
+    def voxelizes(self) -> bool:
+        return "voxelize" in self.passes
+
+
+METHOD_PLANS = {plan.name: plan for plan in (
+    MethodPlan("hao", ("upload", "voxelize", "gbuffer", "voxel_ao", "filter")),
+    MethodPlan("far", ("upload", "gbuffer", "open_ao", "low_gbuffer", "spheres", "filter"), spheres=True),
+    MethodPlan("hao+far", ("upload", "voxelize", "gbuffer", "voxel_ao", "low_gbuffer", "spheres", "filter"),
+               voxels="unproxied", spheres=True),
+    MethodPlan("near", ("upload", "gbuffer", "back_layer", "near_field", "filter")),
+    MethodPlan("near+far", ("upload", "gbuffer", "back_layer", "near_field", "low_gbuffer", "spheres", "filter"),
+               spheres=True),
+)}
+
+
+def method_plan(name: str) -> MethodPlan:
+    """The plan of a method named in view_settings.METHODS."""
+    return METHOD_PLANS[name]
