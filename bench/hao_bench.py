@@ -29,7 +29,7 @@ import bpy  # noqa: E402
 import gpu  # noqa: E402
 import numpy as np  # noqa: E402
 
-from hao_addon.core import camera_math as cm  # noqa: E402
+from hao_addon.core.hao import camera_math as cm  # noqa: E402
 from hao_addon.core import scenes  # noqa: E402
 from hao_addon.core.geometry import TriangleSoup  # noqa: E402
 from hao_addon.core.objfile import obj_soup  # noqa: E402

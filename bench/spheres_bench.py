@@ -32,7 +32,7 @@ import bpy  # noqa: E402
 import gpu  # noqa: E402
 import numpy as np  # noqa: E402
 
-from hao_addon.core import camera_math as cm  # noqa: E402
+from hao_addon.core.hao import camera_math as cm  # noqa: E402
 from hao_addon.core import scenes  # noqa: E402
 from hao_addon.core.proxies.lloyd import lloyd_clusters, sphere_proxies, vertex_areas  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402

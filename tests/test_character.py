@@ -140,7 +140,7 @@ def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
                 o.proxied = o.name in proxied
             tris = np.concatenate([o.world_positions() for o in objects])
             for method in ("hao", "far", "hao+far"):
-                settings = ViewAOSettings(method=method, rays=64, steps=16, max_distance=0.3, grid=256, filter_size=0)
+                settings = ViewAOSettings(method=method, rays=64, max_distance=0.3, grid=256, filter_size=0)
                 renderer.render(objects, vp, w, h, settings, spheres=spheres)
                 pts, nrm, ao = low_res_samples(renderer, settings)
                 on_man = pts[:, 2] > 0.02

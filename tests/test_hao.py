@@ -77,25 +77,32 @@ def test_voxel_grid_matches_cpu_voxelization(renderer):
         assert solid.sum() > surface.sum()  # the torus is filled, not a shell
 
 
-def test_ao_pass_equals_numpy_march(renderer):
+@pytest.mark.parametrize("march, steps, falloff, max_distance", [
+    ("fixed", 8, "wendland", 1.0), ("fixed", 8, "none", 1.0), ("fixed", 16, "wendland", 0.0),
+    ("hierarchical", 256, "wendland", 1.0), ("hierarchical", 256, "none", 0.6), ("hierarchical", 256, "none", 0.0)])
+def test_ao_pass_equals_numpy_march(renderer, march, steps, falloff, max_distance):
+    """Both marches, both falloffs and unlimited distance against the numpy mirror: the fixed
+    march sample for sample, the hierarchical one against an exact DDA of every voxel."""
     objs, _ = sphere_plane_scene()
-    settings = ViewAOSettings(rays=16, steps=8, max_distance=1.0, grid=96)
+    settings = ViewAOSettings(rays=16, steps=steps, max_distance=max_distance, grid=96, march=march, falloff=falloff)
     vp, w, h = view((2.0, -2.5, 2.0))
     renderer.render(objs, vp, w, h, settings)
     pts, nrm, ao = low_res_samples(renderer, settings)
     spec = renderer.spec
     ref = march_reference(renderer.voxels.read_grid(), np.array(spec.origin), spec.voxel, pts, nrm,
-                          settings.rays, settings.steps, settings.spread, settings.max_distance)
+                          settings.rays, settings.steps, settings.spread, settings.max_distance, march, falloff)
     diff = np.abs(ao - ref)
     # float32 on the GPU, float64 here: a sample on a voxel boundary may land on either side.
-    assert np.mean(diff > 1e-4) < 0.01 and diff.mean() < 1e-3
+    assert np.mean(diff > 1e-4) < 0.01 and diff.mean() < 1e-3, (np.mean(diff > 1e-4), diff.mean())
     assert ao.min() < 0.6  # the contact region is dark: the pass did see the sphere
+    if march == "hierarchical":
+        assert renderer.sampling.counts()[1] == 0  # no ray ran out of steps
 
 
 def test_lone_plane_is_open_at_any_tilt(renderer):
     """Self-intersection avoidance: the 1.75-voxel start offset exceeds the sqrt(3)-voxel reach
     of a plane's own voxels, so a lone plane gets exactly 1 whatever its orientation."""
-    settings = ViewAOSettings(rays=32, steps=16, max_distance=0.5, grid=128)
+    settings = ViewAOSettings(rays=32, max_distance=0.5, grid=128)
     for angle in (0.0, 0.3, 0.785, 1.1):
         c, s = np.cos(angle), np.sin(angle)
         rot = np.array([[1, 0, 0], [0, c, -s], [0, s, c]]) @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
@@ -110,7 +117,7 @@ def test_lone_plane_is_open_at_any_tilt(renderer):
 
 def test_bilateral_filter_matches_numpy_reference(renderer):
     objs, _ = sphere_plane_scene()
-    settings = ViewAOSettings(rays=8, steps=8, max_distance=1.0, grid=64, filter_size=6, scale=2)
+    settings = ViewAOSettings(rays=8, max_distance=1.0, grid=64, filter_size=6, scale=2)
     vp, w, h = view((2.0, -2.5, 2.0), width=96, height=72)
     renderer.render(objs, vp, w, h, settings)
     pos, nrm, _ = renderer.gbuffer.read()
@@ -134,7 +141,7 @@ def ground_truth_rmse(renderer, settings, soups, rays=512):
 @pytest.mark.parametrize("rays", [32, 128])
 def test_ao_against_ray_traced_ground_truth(renderer, rays):
     objs, soups = sphere_plane_scene()
-    settings = ViewAOSettings(rays=rays, steps=16, max_distance=1.0, grid=128)
+    settings = ViewAOSettings(rays=rays, max_distance=1.0, grid=128)
     vp, w, h = view((2.0, -2.5, 2.0))
     renderer.render(objs, vp, w, h, settings)
     rmse, bias, n = ground_truth_rmse(renderer, settings, soups)
@@ -150,7 +157,7 @@ def test_sphere_on_plane_against_exact_geometry(renderer):
     """Plane points around a resting sphere against the exact-geometry value with the same
     Wendland kernel (core/scenes.py; it reproduces 1 - (R/D)^3 for unlimited reach)."""
     objs, _ = sphere_plane_scene()
-    settings = ViewAOSettings(rays=128, steps=32, max_distance=1.5, grid=192, filter_size=0)
+    settings = ViewAOSettings(rays=128, max_distance=1.5, grid=192, filter_size=0)
     vp, w, h = view((0.01, -0.01, 4.0), target=(0.0, 0.0, 0.0), width=192, height=192, fov=1.2)
     renderer.render(objs, vp, w, h, settings)
     pts, nrm, ao = low_res_samples(renderer, settings)
@@ -172,7 +179,7 @@ def test_view_independence_occluder_behind_the_camera(renderer):
     wall = scenes.wall(4.0, 1.5, 0.0)  # x = 0, facing -x; the floor strip x in [-0.8, 0] sees it
     objs = [object_from_soup(floor, "floor"), object_from_soup(wall, "wall")]
     # The wall is a sheet (voxelized as a one-voxel shell): steps finer than a voxel hit it.
-    settings = ViewAOSettings(rays=64, steps=64, max_distance=1.5, grid=128)
+    settings = ViewAOSettings(rays=64, max_distance=1.5, grid=128)
     target = (-0.4, 0.0, 0.0)
     views = {"wall on screen": view((-2.5, 0.0, 1.6), target=target),
              "wall behind camera": view((-0.05, 0.0, 1.2), target=(-0.8, 0.0, 0.0))}
@@ -204,7 +211,7 @@ def test_far_from_the_origin_and_at_any_scale(renderer):
     an anchor near the scene, so float32 keeps its precision (without it, positions 1e5
     away are quantized to 0.008, two voxels of this grid)."""
     objs, soups = sphere_plane_scene()
-    settings = ViewAOSettings(rays=32, steps=16, max_distance=1.0, grid=128)
+    settings = ViewAOSettings(rays=32, max_distance=1.0, grid=128)
     eye, target = np.array([2.0, -2.5, 2.0]), np.array([0.0, 0.0, 0.3])
     vp, w, h = view(eye, target)
     renderer.render(objs, vp, w, h, settings)

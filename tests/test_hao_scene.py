@@ -29,7 +29,7 @@ def _scene_objects():
 
 def test_each_pass_runs_only_when_its_inputs_change(renderer):
     objs = _scene_objects()
-    settings = ViewAOSettings(rays=8, steps=8, grid=64)
+    settings = ViewAOSettings(rays=8, grid=64)
     vp, w, h = _view((2.0, -2.5, 2.0))
     runs = lambda: {k: renderer.stats[k] for k in ("upload", "voxelize", "gbuffer", "ao", "filter")}  # noqa: E731
     renderer.render(objs, vp, w, h, settings)
@@ -64,7 +64,7 @@ def test_each_pass_runs_only_when_its_inputs_change(renderer):
 
 def test_background_baked_and_out_of_region_pixels_are_not_sampled(renderer):
     objs = _scene_objects()
-    settings = ViewAOSettings(rays=8, steps=8, grid=64, scale=2)
+    settings = ViewAOSettings(rays=8, grid=64, scale=2)
     vp, w, h = _view((2.0, -2.5, 2.0))
     renderer.render(objs, vp, w, h, settings)
     pos, _, _ = renderer.gbuffer.read()
@@ -74,14 +74,19 @@ def test_background_baked_and_out_of_region_pixels_are_not_sampled(renderer):
     assert all_sampled == int(block_valid.sum()) < block_valid.size  # background skipped
     ao = renderer.read_ao()
     assert (ao[pos[..., 3] == 0.0] == 1.0).all()
-    # The sphere carries a baked map: it still occludes (the floor stays dark) but is not sampled.
+    low = renderer.sampling.read()
+    # The sphere carries a baked map: it still occludes (the floor's AO is unchanged, and
+    # dark near it) but is not sampled.
     baked = [objs[0], dataclasses.replace(objs[1], receiver=0.5)]
     renderer.render(baked, vp, w, h, settings)
     pos_b, _, _ = renderer.gbuffer.read()
     plane_blocks = (pos_b[..., 3] >= 1.0).reshape(h // 2, 2, w // 2, 2).any(axis=(1, 3))
     assert 0 < renderer.sampled_pixels() <= int(plane_blocks.sum()) < all_sampled + 1
     assert renderer.sampled_pixels() < all_sampled
-    assert renderer.read_ao().min() < 0.7
+    low_b = renderer.sampling.read()
+    floor = (pos[..., 2] < 1e-4).reshape(h // 2, 2, w // 2, 2).all(axis=(1, 3)) & block_valid
+    np.testing.assert_array_equal(low_b[floor], low[floor])
+    assert low_b[floor].min() < 0.7
     # A region of interest around the sphere only: floor pixels outside it are skipped.
     renderer.render(objs, vp, w, h, settings, region=(np.array([-0.6, -0.6, -0.1]), np.array([0.6, 0.6, 1.1])))
     assert renderer.sampled_pixels() < all_sampled // 2
@@ -93,7 +98,7 @@ def test_fifty_frames_leave_no_gpu_state_or_resources(gpu_context):
     from hao_addon.gpu.hao_renderer import HaoRenderer
 
     objs = _scene_objects()
-    settings = ViewAOSettings(rays=4, steps=4, grid=64)
+    settings = ViewAOSettings(rays=4, grid=64)
     offscreen = gpu.types.GPUOffScreen(64, 64)
     with offscreen.bind():
         before = util.snapshot_state()
@@ -217,7 +222,7 @@ def test_composite_darkens_by_ao_and_respects_depth(renderer):
 
     objs = _scene_objects()
     vp, w, h = _view((2.0, -2.5, 2.0))
-    renderer.render(objs, vp, w, h, ViewAOSettings(rays=8, steps=8, grid=64))
+    renderer.render(objs, vp, w, h, ViewAOSettings(rays=8, grid=64))
     ao = renderer.read_ao()
     _, _, depth = renderer.gbuffer.read()
     # "Blender's" depth buffer: the same meshes drawn again (so the surfaces are front-most),

@@ -12,7 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
-FALLOFFS = ("none", "wendland")
+from .setting_spec import Choice
+
+# The falloff setting's choices, shared by the bake and the viewport AO.
+FALLOFF_CHOICES = (
+    Choice("none", "None", "full occlusion up to the max distance, none beyond"),
+    Choice("wendland", "Smooth (Wendland)", "fades smoothly to zero at the max distance (Hybrid AO paper, eq. 3)"),
+)
+FALLOFFS = tuple(c.value for c in FALLOFF_CHOICES)
 
 
 def wendland(t: np.ndarray, h: float) -> np.ndarray:

@@ -60,13 +60,23 @@ PASSES = {
     "gbuffer": PassSpec(("upload", "view"), (), "gbuffer"),
     "back_layer": PassSpec(("upload", "view"), (), "back_layer"),
     "low_gbuffer": PassSpec(("gbuffer",), ("scale",), "low_gbuffer"),
-    "voxel_ao": PassSpec(("gbuffer", "voxelize"), ("scale", "rays", "steps", "spread", "max_distance"), "ao",
-                         AO_MAP),
+    "voxel_ao": PassSpec(("gbuffer", "voxelize"), ("scale", "rays", "steps", "march", "spread", "max_distance",
+                                                   "falloff"), "ao", AO_MAP),
     "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance"), "near", AO_MAP),
     "open_ao": PassSpec(("gbuffer",), ("scale",), "open_ao", AO_MAP),
     "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres"), ("epsilon",), "far", AO_MAP),
-    "filter": PassSpec((AO_MAP,), ("filter_size", "max_distance"), "filter"),
+    "filter": PassSpec((AO_MAP, "grid"), ("filter_size", "max_distance"), "filter"),
 }
+
+
+# The bilateral filter's position weight reaches 0 at d_max; at unlimited distance at this
+# many voxels of the grid.
+UNLIMITED_FILTER_VOXELS = 32
+
+
+def filter_range(settings: ViewAOSettings, spec: GridSpec) -> float:
+    """Distance (world units) at which the bilateral filter's position weight reaches 0."""
+    return settings.max_distance if settings.max_distance > 0.0 else UNLIMITED_FILTER_VOXELS * spec.voxel
 
 
 def _boxes_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
@@ -161,7 +171,7 @@ class HaoRenderer(util.GPUPass):
             spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
         inputs = {
             "geometry": (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes()),
-            "grid": (inside, self.spec, anchor.tobytes()),
+            "grid": (inside, self.spec, anchor.tobytes(), settings.march),
             "view": (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height),
             "spheres": ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes())
                         if spheres is not None else None),
@@ -205,7 +215,10 @@ class HaoRenderer(util.GPUPass):
         self.back.set_geometry(pos, nrm, flags)
 
     def _run_voxelize(self, frame: Frame) -> None:
-        self.voxels.voxelize(self.spec)
+        # Closed objects are filled only for the paper's march, which steps over shells; the
+        # hierarchical march visits every voxel, and a fill would darken what a scan's holes
+        # leak it into (the floor under the Stanford bunny's open base).
+        self.voxels.voxelize(self.spec, solids=frame.settings.march == "fixed")
 
     def _run_gbuffer(self, frame: Frame) -> None:
         self.gbuffer.render(frame.view_proj, frame.width, frame.height)
@@ -233,7 +246,7 @@ class HaoRenderer(util.GPUPass):
         self.far.run(self.low_gbuffer, self.sampling.ao_low, centres, radii, frame.settings.epsilon, frame.view_proj)
 
     def _run_filter(self, frame: Frame) -> None:
-        self.filter.run(self.gbuffer, self.sampling.ao_low, frame.settings)
+        self.filter.run(self.gbuffer, self.sampling.ao_low, frame.settings, filter_range(frame.settings, self.spec))
 
     @property
     def ao_texture(self) -> "gpu.types.GPUTexture":

@@ -14,23 +14,35 @@ from .shaders import add_defines, cached_shader, glsl_source
 GROUP = 8
 
 
-def _ao_info() -> "gpu.types.GPUShaderCreateInfo":
+# Cells are looked up this far (voxels) past each boundary a hierarchical march crosses:
+# far above float32's rounding of t in a 512-voxel grid (6e-5), far below what matters.
+MARCH_NUDGE = 1e-3
+
+
+def _ao_info(march: str, falloff: str) -> "gpu.types.GPUShaderCreateInfo":
+    """march: 'hierarchical' or 'fixed' (hao_march.glsl); falloff: 'none' or 'wendland'."""
     info = gpu.types.GPUShaderCreateInfo()
     info.local_group_size(GROUP, GROUP, 1)
+    if march == "hierarchical":
+        info.define("MARCH_HIERARCHICAL", "1")
+    if falloff == "wendland":
+        info.define("WENDLAND_FALLOFF", "1")
+    info.define("MARCH_NUDGE", repr(MARCH_NUDGE))
     info.push_constant('VEC4', "grid_origin")
     info.push_constant('IVEC4', "grid_dims")
     info.push_constant('IVEC2', "full_size")
     info.push_constant('INT', "scale")
     info.push_constant('INT', "rays")
     info.push_constant('INT', "steps")
+    info.push_constant('INT', "levels")
     info.push_constant('FLOAT', "spread")
     info.push_constant('FLOAT', "max_distance")
     declare_gbuffer_images(info)
     info.image(2, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
-    info.image(4, 'R32UI', 'UINT_2D', "sampled_count", qualifiers={'READ', 'WRITE'})
+    info.image(4, 'R32UI', 'UINT_2D', "counters", qualifiers={'READ', 'WRITE'})
     add_defines(info, GLSL_DEFINES)
-    info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "hao_ao.comp"))
+    info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "hao_march.glsl", "hao_ao.comp"))
     return info
 
 
@@ -93,8 +105,8 @@ class LowGBufferPass(util.GPUPass):
         self.size = (0, 0)
 
 
-def ao_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("hao_ao",), _ao_info)
+def ao_shader(march: str, falloff: str) -> "gpu.types.GPUShader":
+    return cached_shader(("hao_ao", march, falloff), lambda: _ao_info(march, falloff))
 
 
 def bilateral_shader(axis: int, upsample: bool) -> "gpu.types.GPUShader":
@@ -138,10 +150,10 @@ class AOSamplingPass(util.GPUPass):
         k = settings.scale
         low = self._ensure(gbuffer, k)
         if self.counter is None:
-            self.counter = gpu.types.GPUTexture((1, 1), format='R32UI')
+            self.counter = gpu.types.GPUTexture((2, 1), format='R32UI')
         self.counter.clear(format='UINT', value=(0,))
         spec = voxels.spec
-        shader = ao_shader()
+        shader = ao_shader(settings.march, settings.falloff)
         shader.bind()
         shader.uniform_float("grid_origin", (*spec.origin, spec.voxel))
         shader.uniform_int("grid_dims", (*spec.dims, 0))
@@ -149,22 +161,28 @@ class AOSamplingPass(util.GPUPass):
         shader.uniform_int("scale", k)
         shader.uniform_int("rays", settings.rays)
         shader.uniform_int("steps", settings.steps)
+        _set_optional(shader, "levels", voxels.levels, integer=True)
         shader.uniform_float("spread", settings.spread)
         shader.uniform_float("max_distance", settings.max_distance)
         bind_gbuffer_images(shader, gbuffer)
         shader.image("grid", voxels.grid)
         shader.image("ao_low", self.ao_low)
-        shader.image("sampled_count", self.counter)
+        shader.image("counters", self.counter)
         gpu.compute.dispatch(shader, -(-low[0] // GROUP), -(-low[1] // GROUP), 1)
         gpu.shader.unbind()
 
     def read(self) -> np.ndarray:
         return util.texture_to_numpy(self.ao_low)
 
-    def sampled_pixels(self) -> int:
+    def counts(self) -> tuple[int, int]:
+        """(AO-map pixels the last pass marched, rays that spent their step budget)."""
         if self.counter is None:
-            return 0
-        return int(util.texture_to_numpy(self.counter, np.uint32).ravel()[0])
+            return 0, 0
+        values = util.texture_to_numpy(self.counter, np.uint32).ravel()
+        return int(values[0]), int(values[1])
+
+    def sampled_pixels(self) -> int:
+        return self.counts()[0]
 
     def _release(self) -> None:
         self.ao_low = self.counter = None
@@ -179,7 +197,8 @@ class BilateralPass(util.GPUPass):
         self.middle = self.ao = None
         self.size = (0, 0)
 
-    def run(self, gbuffer, ao_low, settings: ViewAOSettings) -> None:
+    def run(self, gbuffer, ao_low, settings: ViewAOSettings, position_range: float) -> None:
+        """position_range: the distance at which the position weight w_p reaches 0."""
         width, height = gbuffer.size
         if self.size != (width, height):
             self.middle = gpu.types.GPUTexture((width, height), format='R32F')
@@ -191,7 +210,7 @@ class BilateralPass(util.GPUPass):
             shader.uniform_int("full_size", (width, height))
             _set_optional(shader, "scale", settings.scale, integer=True)
             shader.uniform_int("filter_size", settings.filter_size)
-            shader.uniform_float("max_distance", settings.max_distance)
+            shader.uniform_float("max_distance", position_range)
             bind_gbuffer_images(shader, gbuffer)
             shader.image("ao_src", src)
             shader.image("ao_dst", dst)

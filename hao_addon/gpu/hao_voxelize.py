@@ -1,12 +1,14 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Voxelization pass of Hybrid Ambient Occlusion: scene triangles -> bit-packed R32UI 3D grid
-(bits along z), by fragment-shader image atomics (rules: hao_addon/core/hao/voxel_grid.py)."""
+(bits along z), by fragment-shader image atomics (rules: hao_addon/core/hao/voxel_grid.py),
+then its occupancy pyramid (one compute dispatch per level) beside it in the same texture,
+for the hierarchical march."""
 from __future__ import annotations
 
 import gpu
 import numpy as np
 
-from ..core.hao.voxel_grid import GridSpec
+from ..core.hao.voxel_grid import GridSpec, atlas_words, level_count, level_dims, level_offsets
 from . import util
 from .shaders import cached_shader, glsl_source
 
@@ -48,10 +50,25 @@ void main()
   if (any(greaterThanEqual(c, grid_dims.xyz))) {
     return;
   }
-  imageStore(flat_words, ivec2(c.x, c.y + c.z * grid_dims.y), imageLoad(grid, c));
+  imageStore(flat_words, ivec2(c.x, c.y + c.z * grid_dims.y), imageLoad(grid, c + ivec3(grid_dims.w, 0, 0)));
 }
 """)
     return info
+
+
+def _pyramid_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.local_group_size(4, 4, 4)
+    info.image(0, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ', 'WRITE'})
+    info.push_constant('IVEC4', "fine_words")  # x cells, y cells, z words, atlas x offset
+    info.push_constant('IVEC4', "coarse_words")
+    info.compute_source(glsl_source("hao_pyramid.comp"))
+    return info
+
+
+def _level_words(dims: tuple[int, int, int], level: int) -> tuple[int, int, int, int]:
+    nx, ny, nz = level_dims(dims, level)
+    return nx, ny, -(-nz // 32), level_offsets(dims)[level]
 
 
 class VoxelPass(util.GPUPass):
@@ -62,6 +79,7 @@ class VoxelPass(util.GPUPass):
         self.surface_batch = self.solid_batch = None
         self.grid = None
         self.spec: GridSpec | None = None
+        self.levels = 1
         self.triangles = 0
         self._plane, self._plane_fb, self._plane_side = None, None, 0
 
@@ -76,11 +94,14 @@ class VoxelPass(util.GPUPass):
         self.solid_batch = (util.make_batch('TRIS', {"pos": ('F32', sp), "axis": ('F32', np.zeros(len(sp)))})
                             if len(sp) else None)
 
-    def voxelize(self, spec: GridSpec) -> None:
-        words = spec.words
-        if self.grid is None or self.spec is None or self.spec.words != words:
+    def voxelize(self, spec: GridSpec, solids: bool = True) -> None:
+        """Voxelize the geometry into a grid of spec (solids: the closed objects filled, see
+        core/hao/voxel_grid.py), then build its pyramid."""
+        words = atlas_words(spec.dims)
+        if self.grid is None or self.spec is None or atlas_words(self.spec.dims) != words:
             self.grid = gpu.types.GPUTexture(words, format='R32UI')
         self.spec = spec
+        self.levels = level_count(spec.dims)
         self.grid.clear(format='UINT', value=(0,))
         side = max(spec.dims)
         if self._plane_side != side:  # the colour target only sizes the raster plane
@@ -91,7 +112,7 @@ class VoxelPass(util.GPUPass):
             util.set_overlay_pass_state(side, side)
             # Parity first, then the surface ORed over it: XOR and OR do not commute.
             for solid, batch in ((True, self.solid_batch), (False, self.surface_batch)):
-                if batch is None:
+                if batch is None or (solid and not solids):
                     continue
                 size = (spec.dims[0], spec.dims[1]) if solid else (side, side)  # solid: columns along z
                 gpu.state.viewport_set(0, 0, *size)
@@ -103,22 +124,34 @@ class VoxelPass(util.GPUPass):
                 shader.image("grid", self.grid)
                 batch.draw(shader)
                 util.image_barrier()
+        self._build_pyramid()
 
-    def read_grid(self) -> np.ndarray:
-        """(nz, ny, nx) bool copy of the grid (for tests; a compute copy into 2D, since
-        GPUTexture.read() returns only the first slice of a 3D texture)."""
-        nx, ny, nw = self.spec.words
+    def _build_pyramid(self) -> None:
+        shader = cached_shader(("hao_pyramid",), _pyramid_info)
+        shader.bind()
+        shader.image("grid", self.grid)
+        for level in range(1, self.levels):
+            coarse = _level_words(self.spec.dims, level)
+            shader.uniform_int("fine_words", _level_words(self.spec.dims, level - 1))
+            shader.uniform_int("coarse_words", coarse)
+            gpu.compute.dispatch(shader, -(-coarse[0] // 4), -(-coarse[1] // 4), -(-coarse[2] // 4))
+        gpu.shader.unbind()
+
+    def read_grid(self, level: int = 0) -> np.ndarray:
+        """(nz, ny, nx) bool copy of a level of the pyramid, 0 the grid (for tests; a compute
+        copy into 2D, since GPUTexture.read() returns only the first slice of a 3D texture)."""
+        nx, ny, nw, x0 = _level_words(self.spec.dims, level)
         flat = gpu.types.GPUTexture((nx, ny * nw), format='R32UI')
         shader = cached_shader(("hao_unpack",), _unpack_info)
         shader.bind()
-        shader.uniform_int("grid_dims", (nx, ny, nw, 0))
+        shader.uniform_int("grid_dims", (nx, ny, nw, x0))
         shader.image("grid", self.grid)
         shader.image("flat_words", flat)
         gpu.compute.dispatch(shader, -(-nx // 8), -(-ny // 8), nw)
         gpu.shader.unbind()
         words = util.texture_to_numpy(flat, np.uint32).reshape(nw, ny, nx)
         from ..core.hao.voxel_grid import unpack_bits
-        return unpack_bits(words)
+        return unpack_bits(words)[:level_dims(self.spec.dims, level)[2]]
 
     def _release(self) -> None:
         self.surface_batch = self.solid_batch = self.grid = None

@@ -8,15 +8,12 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
 
 MAX_DIRECTIONS = 65536
 MAX_MAP_SIZE = 16384
 
-FALLOFF_CHOICES = (
-    Choice("none", "None", "full occlusion up to the max distance, none beyond"),
-    Choice("wendland", "Smooth (Wendland)", "fades smoothly to zero at the max distance (Hybrid AO paper, eq. 3)"),
-)
 WEIGHTING_CHOICES = (
     Choice("cosine", "Cosine", "Lambertian ambient occlusion (what Cycles bakes)"),
     Choice("uniform", "Uniform", "fraction of the open hemisphere"),

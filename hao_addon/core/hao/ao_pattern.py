@@ -21,12 +21,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels import wendland
+from ..kernels import occlusion_weight
 
 GOLDEN_FRACTION = 0.6180339887498949
 SELF_OFFSET = 1.75  # voxels; > sqrt(3)
+# The hierarchical march starts on the surface and ignores occupied voxels whose centre lies
+# within this many voxels above the receiver's tangent plane: its own surface's voxels have
+# centres within sqrt(3)/2 = 0.87 of it; the rest allows for a shading normal tilted from
+# the face.
+SELF_SLAB = 1.0
 # What the GPU passes that mirror this module get as defines (hao_ao.comp, near_field.comp).
-GLSL_DEFINES = {"HAO_GOLDEN_FRACTION": GOLDEN_FRACTION, "HAO_SELF_OFFSET": SELF_OFFSET}
+GLSL_DEFINES = {"HAO_GOLDEN_FRACTION": GOLDEN_FRACTION, "HAO_SELF_OFFSET": SELF_OFFSET, "HAO_SELF_SLAB": SELF_SLAB}
 
 
 def pcg3d(v: np.ndarray) -> np.ndarray:
@@ -74,20 +79,79 @@ def ray_directions(normals: np.ndarray, jitter: np.ndarray, rays: int, spread: f
         + z[..., None] * np.asarray(normals, np.float64)[:, None]
 
 
+def dda_first_hits(occupied: np.ndarray, starts: np.ndarray, dirs: np.ndarray, t_max,
+                   planes: np.ndarray | None = None, slab: float = 0.0) -> np.ndarray:
+    """Exact 3D-DDA (Amanatides & Woo) through a bool grid, in grid units (voxels of side 1
+    from the grid's corner): starts (n, 3), unit dirs (n, 3), t_max (n,) or a scalar
+    (np.inf: to the grid's exit). Returns (n,) float64: the ray parameter where the segment
+    [0, t_max) enters the first occupied voxel it passes through (or passes that voxel's
+    centre, where later), np.inf where none; with
+    planes (n, 3) unit normals, only voxels whose centre lies more than `slab` above the plane
+    through the start count. Every voxel the segment's interior crosses is visited, so none is
+    stepped over; the GPU's hierarchical march (hao_march.glsl) must find the same voxel."""
+    occupied = np.asarray(occupied, bool)
+    starts = np.asarray(starts, np.float64)
+    dirs = np.asarray(dirs, np.float64)
+    n = len(starts)
+    dims = np.array(occupied.shape[::-1], np.float64)
+    safe = np.where(dirs == 0.0, 1e-300, dirs)
+    inv = 1.0 / safe
+    t0, t1 = (0.0 - starts) * inv, (dims - starts) * inv
+    t_in = np.maximum(np.minimum(t0, t1).max(axis=1), 0.0)
+    t_end = np.minimum(np.maximum(t0, t1).min(axis=1), np.broadcast_to(np.asarray(t_max, np.float64), (n,)))
+    out = np.full(n, np.inf)
+    step = np.where(dirs > 0.0, 1, -1)
+    cell = np.clip(np.floor(starts + dirs * t_in[:, None]).astype(np.int64), 0, dims.astype(np.int64) - 1)
+    t_next = np.where(dirs == 0.0, np.inf, ((cell + (step > 0)) - starts) * inv)
+    t_delta = np.where(dirs == 0.0, np.inf, np.abs(inv))
+    t_cur = t_in.copy()
+    live = np.flatnonzero(t_in < t_end)
+    rows = np.arange(n)
+    while len(live):
+        c = cell[live]
+        hit = occupied[c[:, 2], c[:, 1], c[:, 0]]
+        if planes is not None:
+            hit &= np.einsum("ij,ij->i", c + 0.5 - starts[live], planes[live]) > slab
+        # The hit distance: the voxel centre's along the ray (a surface runs through a voxel's
+        # middle on average), never before the voxel's entry.
+        centre_t = np.einsum("ij,ij->i", c + 0.5 - starts[live], dirs[live])
+        out[live[hit]] = np.maximum(t_cur[live[hit]], centre_t[hit])
+        live = live[~hit]
+        axis = np.argmin(t_next[live], axis=1)
+        r = rows[live]
+        t_cur[r] = t_next[r, axis]
+        cell[r, axis] += step[r, axis]
+        t_next[r, axis] += t_delta[r, axis]
+        inside = ((cell[r] >= 0) & (cell[r] < dims.astype(np.int64))).all(axis=1)
+        live = live[inside & (t_cur[r] < t_end[r])]
+    return out
+
+
 def march_reference(occupied: np.ndarray, origin: np.ndarray, voxel: float, points: np.ndarray,
-                    normals: np.ndarray, rays: int, steps: int, spread: float, max_distance: float) -> np.ndarray:
+                    normals: np.ndarray, rays: int, steps: int, spread: float, max_distance: float,
+                    march: str = "fixed", falloff: str = "wendland") -> np.ndarray:
     """Accessibility (n,) at (n, 3) points with unit normals against an (nz, ny, nx) bool
-    grid, by exactly the GPU's rule (see the module docstring)."""
+    grid, by the GPU's rules (see the module docstring). march: 'fixed' (the paper's
+    `steps` samples) or 'hierarchical' (every voxel on the ray, exact DDA: the GPU's budget of
+    `steps` traversal steps is assumed large enough); max_distance <= 0: unlimited (rays run
+    to the grid's exit and every hit occludes fully)."""
     points = np.asarray(points, np.float64)
     normals = np.asarray(normals, np.float64)
     jitter = point_jitter(points, voxel)
     dirs = ray_directions(normals, jitter, rays, spread)
+    if march == "hierarchical":
+        t_max = max_distance / voxel if max_distance > 0.0 else np.inf
+        grid_start = (np.repeat(points, rays, axis=0) - np.asarray(origin)) / voxel
+        hit_t = dda_first_hits(occupied, grid_start, dirs.reshape(-1, 3), t_max, np.repeat(normals, rays, axis=0),
+                               SELF_SLAB).reshape(len(points), rays)
+        return 1.0 - occlusion_weight(hit_t * voxel, max_distance, falloff).mean(axis=1)
     offset = SELF_OFFSET * voxel
     start = points + normals * offset
+    reach = max_distance if max_distance > 0.0 else fixed_march_reach(occupied.shape, voxel)
     nz, ny, nx = occupied.shape
     hit_t = np.full(dirs.shape[:2], np.inf)
     for j in range(steps - 1, -1, -1):  # last to first: the first hit wins
-        t = max_distance * (j + jitter[:, 2:3]) / steps
+        t = reach * (j + jitter[:, 2:3]) / steps
         q = start[:, None] + dirs * t[..., None]
         g = np.floor((q - np.asarray(origin)) / voxel).astype(np.int64)
         inside = ((g >= 0) & (g < np.array([nx, ny, nz]))).all(-1)
@@ -95,5 +159,9 @@ def march_reference(occupied: np.ndarray, origin: np.ndarray, voxel: float, poin
         gi = g[inside]
         occ[inside] = occupied[gi[:, 2], gi[:, 1], gi[:, 0]]
         hit_t = np.where(occ, np.broadcast_to(t, hit_t.shape) + offset, hit_t)
-    w = np.where(np.isfinite(hit_t), wendland(np.where(np.isfinite(hit_t), hit_t, 0.0), max_distance), 0.0)
-    return 1.0 - w.mean(axis=1)
+    return 1.0 - occlusion_weight(hit_t, max_distance, falloff).mean(axis=1)
+
+
+def fixed_march_reach(shape: tuple[int, int, int], voxel: float) -> float:
+    """The fixed march's reach at unlimited distance: the grid's diagonal."""
+    return float(np.linalg.norm(shape)) * voxel

@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Settings of the viewport / render-time Hybrid Ambient Occlusion (pure Python).
 
-Defaults follow the HAO paper's Table 1 (32 rays, 8 steps, 256^3 grid, AO map at half the
-screen resolution per axis, bilateral filter of 16 pixels). Each field is the one definition
+Defaults follow the HAO paper's Table 1 (32 rays, 256^3 grid, AO map at half the screen
+resolution per axis, bilateral filter of 16 pixels), except the march: the paper's 8 fixed
+steps step over thin walls and objects far inside d_max, so rays walk every voxel with a
+budget of DEFAULT_STEPS traversal steps (march 'fixed', steps 8 is the paper's). Each field is the one definition
 of its setting; the panel's properties, render-ao's options and the README table come from it.
 """
 from __future__ import annotations
@@ -10,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from .methods import method_plan
+from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
 
 GRID_MIN, GRID_MAX = 64, 512
@@ -25,21 +28,33 @@ METHOD_CHOICES = (
     Choice("near+far", "Near Field + Spheres", "near field plus the sphere proxies (the paper's combination)"),
 )
 METHODS = tuple(c.value for c in METHOD_CHOICES)
+MARCH_CHOICES = (
+    Choice("hierarchical", "Hierarchical", "every voxel on a ray is visited (exact 3D-DDA; coarse levels of an "
+                                           "occupancy pyramid skip empty space), so no thin wall is stepped over"),
+    Choice("fixed", "Fixed Steps", "the paper's march: Steps samples spaced d_max / Steps apart, which can step "
+                                   "over walls thinner than that"),
+)
+DEFAULT_STEPS = 64
 
 
 @dataclass(frozen=True)
 class ViewAOSettings:
     rays: int = setting(32, label="Rays", minimum=1, maximum=1024, soft_max=128,
                         description="rays per AO-map pixel; the main cost (paper default 32)")
-    steps: int = setting(8, label="Steps", minimum=1, maximum=256, soft_max=32,
-                         description="fixed occupancy tests along each ray (paper default 8)")
+    steps: int = setting(DEFAULT_STEPS, label="Steps", minimum=1, maximum=1024, soft_max=256,
+                         description="traversal steps per ray: the hierarchical march's budget (a ray that spends "
+                                     "it counts as open; rarely reached at the default), or the fixed march's "
+                                     "samples (paper default 8)")
+    march: str = setting("hierarchical", label="March", choices=MARCH_CHOICES, description="how rays walk the voxels")
     spread: float = setting(1.0, label="Spread", minimum=0.05, maximum=1.0,
                             description="cone of the rays: 1 = the whole hemisphere (the AO definition); "
                                         "smaller gives sharper, more contrasted AO")
-    max_distance: float = setting(1.0, label="Distance", noun="max distance", minimum=0.0, above_minimum=True,
+    max_distance: float = setting(1.0, label="Distance", noun="max distance", minimum=0.0,
                                   soft_max=100.0, unit="scene units", subtype='DISTANCE',
-                                  description="the maximum distance d_max: occluders farther than this do not darken; closer ones "
-                                              "fade in smoothly (Wendland kernel)")
+                                  description="the maximum distance d_max: occluders farther than this do not darken; "
+                                              "0 = unlimited (what Cycles' AO and the bake compute)")
+    falloff: str = setting("wendland", label="Falloff", choices=FALLOFF_CHOICES,
+                           description="how occlusion fades with distance (only with a max distance)")
     grid: int = setting(256, label="Grid", minimum=GRID_MIN, maximum=GRID_MAX, unit="voxels",
                         description="voxels along the longest side of the region of interest")
     scale: int = setting(2, label="AO Scale", noun="scale", minimum=1, maximum=8,

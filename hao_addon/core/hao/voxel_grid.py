@@ -182,3 +182,55 @@ def unpack_bits(words: np.ndarray) -> np.ndarray:
     nw, ny, nx = words.shape
     bits = (words[:, None] >> np.arange(32, dtype=np.uint32)[None, :, None, None]) & 1
     return bits.reshape(nw * 32, ny, nx).astype(bool)
+
+
+# Occupancy pyramid (hierarchical traversal): level L is the grid max-pooled by 2^L per axis
+# (a cell is occupied when any voxel in it is), bit-packed along z like level 0. On the GPU
+# the levels sit side by side along x in one R32UI 3D texture (the atlas): level L at x
+# offset level_offsets(dims)[L]. The coarsest level is the first whose longest side is at
+# most PYRAMID_TOP_SIDE cells (MAX_LEVELS at most, a GLSL define).
+MAX_LEVELS = 10
+PYRAMID_TOP_SIDE = 4
+
+
+def level_count(dims: tuple[int, int, int]) -> int:
+    """Levels of the pyramid of a grid of dims (nx, ny, nz), level 0 included."""
+    levels, side = 1, max(dims)
+    while side > PYRAMID_TOP_SIDE and levels < MAX_LEVELS:
+        side = -(-side // 2)
+        levels += 1
+    return levels
+
+
+def level_dims(dims: tuple[int, int, int], level: int) -> tuple[int, int, int]:
+    """(nx, ny, nz) cells of a level: ceil(n / 2^level) per axis."""
+    return tuple(-(-int(n) // (1 << level)) for n in dims)
+
+
+def level_offsets(dims: tuple[int, int, int]) -> list[int]:
+    """x offset of each level in the atlas."""
+    offsets, x = [], 0
+    for level in range(level_count(dims)):
+        offsets.append(x)
+        x += level_dims(dims, level)[0]
+    return offsets
+
+
+def atlas_words(dims: tuple[int, int, int]) -> tuple[int, int, int]:
+    """Texel size (x, y, z words) of the atlas holding every level of a grid of dims."""
+    last = level_count(dims) - 1
+    return (level_offsets(dims)[last] + level_dims(dims, last)[0], int(dims[1]), -(-int(dims[2]) // 32))
+
+
+def occupancy_pyramid(occupied: np.ndarray) -> list[np.ndarray]:
+    """(nz, ny, nx) bool -> [level 0, level 1, ...], each (nz_L, ny_L, nx_L) bool, the numpy
+    twin of the GPU's pyramid pass (gpu_shaders/hao_pyramid.comp)."""
+    levels = [np.asarray(occupied, bool)]
+    dims = occupied.shape[::-1]
+    for level in range(1, level_count(dims)):
+        fine = levels[-1]
+        nz, ny, nx = level_dims(dims, level)[::-1]
+        padded = np.zeros((2 * nz, 2 * ny, 2 * nx), bool)
+        padded[:fine.shape[0], :fine.shape[1], :fine.shape[2]] = fine
+        levels.append(padded.reshape(nz, 2, ny, 2, nx, 2).any(axis=(1, 3, 5)))
+    return levels

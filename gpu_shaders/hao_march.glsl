@@ -1,0 +1,91 @@
+/* The AO pass's voxel marches (hao_ao.comp), in grid units (voxels of side 1 from the grid's
+ * corner). Numpy twins: core/hao/ao_pattern.py (march_reference, dda_first_hits).
+ * The grid is the atlas of the occupancy pyramid (core/hao/voxel_grid.py): level L, cells of
+ * 2^L voxels, at x offset sum of the finer levels' widths; bits along z. */
+
+/* Cells of `level` per axis. */
+ivec3 level_cells(int level)
+{
+  return (grid_dims.xyz + (1 << level) - 1) >> level;
+}
+
+bool cell_occupied(int offset, ivec3 cells, ivec3 c)
+{
+  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, cells))) {
+    return false;
+  }
+  uint word = imageLoad(grid, ivec3(offset + c.x, c.y, c.z >> 5)).r;
+  return ((word >> uint(c.z & 31)) & 1u) != 0u;
+}
+
+/* Hierarchical 3D-DDA: from the surface point o along unit d, the parameter t where the ray
+ * enters the first occupied voxel before t_limit whose centre lies more than HAO_SELF_SLAB
+ * voxels above o's tangent plane (normal n), or -1. The slab holds every voxel the receiver's
+ * own surface marks near o (their centres lie within sqrt(3)/2 of it), so the ray can start
+ * on the surface instead of SELF_OFFSET voxels off it, inside whatever else is that close.
+ * Where a coarse cell is empty the ray jumps to its exit; where it is occupied it descends,
+ * and only an occupied voxel of level 0 ends the ray, so no occupied voxel on the path is
+ * stepped over (cells are looked up a nudge of MARCH_NUDGE voxels past each boundary, which
+ * only misses voxels a ray clips by less). Leaving a cell into another parent climbs one
+ * level. Each loop is one step of the budget; a ray that spends it sets `exhausted` and
+ * counts as open. */
+float march_hierarchical(vec3 o, vec3 n, vec3 d, float t_limit, int budget, int levels, inout bool exhausted)
+{
+  vec3 dir = vec3(abs(d.x) < 1e-12 ? 1e-12 : d.x, abs(d.y) < 1e-12 ? 1e-12 : d.y, abs(d.z) < 1e-12 ? 1e-12 : d.z);
+  vec3 inv = 1.0 / dir;
+  vec3 t0 = -o * inv;
+  vec3 t1 = (vec3(grid_dims.xyz) - o) * inv;
+  vec3 t_near = min(t0, t1);
+  vec3 t_far = max(t0, t1);
+  float t = max(max(max(t_near.x, t_near.y), t_near.z), 0.0);
+  float t_end = min(min(min(t_far.x, t_far.y), t_far.z), t_limit);
+  vec3 toward = step(vec3(0.0), dir); /* 1 where the ray runs towards + */
+  int level = 0;
+  int offset = 0;
+  ivec3 cells = grid_dims.xyz;
+  for (int i = 0; i < budget; i++) {
+    if (t >= t_end) {
+      return -1.0;
+    }
+    float side = float(1 << level);
+    ivec3 c = ivec3(floor((o + d * (t + MARCH_NUDGE)) / side));
+    if (cell_occupied(offset, cells, c)) {
+      if (level > 0) {
+        level--;
+        cells = level_cells(level);
+        offset -= cells.x;
+        continue;
+      }
+      vec3 centre = vec3(c) + 0.5 - o;
+      if (dot(centre, n) > HAO_SELF_SLAB) {
+        /* The surface inside runs through the voxel's middle on average, not its entry. */
+        return max(t, dot(centre, d));
+      }
+    }
+    vec3 t_exit = ((vec3(c) + toward) * side - o) * inv;
+    int axis = (t_exit.x <= t_exit.y && t_exit.x <= t_exit.z) ? 0 : ((t_exit.y <= t_exit.z) ? 1 : 2);
+    int here = c[axis];
+    int next = here + (dir[axis] > 0.0 ? 1 : -1);
+    if (level + 1 < levels && (next >> 1) != (here >> 1)) {
+      offset += cells.x;
+      level++;
+      cells = level_cells(level);
+    }
+    t = max(t_exit[axis], t + MARCH_NUDGE);
+  }
+  exhausted = true;
+  return -1.0;
+}
+
+/* The paper's march: `steps` samples at t_j = reach (j + jitter) / steps; the first
+ * occupied one ends the ray (returns its t, or -1). */
+float march_fixed(vec3 o, vec3 d, float reach, int steps, float jitter)
+{
+  for (int j = 0; j < steps; j++) {
+    float t = (float(j) + jitter) / float(steps) * reach;
+    if (cell_occupied(0, grid_dims.xyz, ivec3(floor(o + d * t)))) {
+      return t;
+    }
+  }
+  return -1.0;
+}
