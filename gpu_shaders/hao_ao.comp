@@ -1,9 +1,10 @@
 /* AO sampling (HAO paper, equation 4) at the reduced resolution: N rays of a regular,
  * cosine-distributed pattern jittered by an object-space hash, marched through the voxel
- * grid (hao_march.glsl: hierarchical, or the paper's fixed steps), each hit weighted by the
- * falloff of its distance. The numpy mirror is hao_addon/core/hao/ao_pattern.py. Output:
- * accessibility, 1 for background and skipped pixels. Counters: [0] sampled pixels, [1]
- * rays that spent their step budget. */
+ * grids (hao_march.glsl: hierarchical from the finest cascade holding the point outwards,
+ * or the paper's fixed steps in one grid), each hit weighted by the falloff of its distance.
+ * The numpy mirror is hao_addon/core/hao/ao_pattern.py. Output: accessibility, 1 for
+ * background and skipped pixels. Counters: [0] sampled pixels, [1] rays that spent their
+ * step budget. */
 
 /* Occlusion of a hit at distance t (world units, the start offset included). */
 float hit_weight(float t)
@@ -18,6 +19,18 @@ float hit_weight(float t)
 #endif
 }
 
+/* The finest cascade holding point q, or -1 (outside the region). */
+int cascade_of(vec3 q)
+{
+  for (int k = 0; k < cascades.count.x; k++) {
+    vec3 g = (q - cascades.origin_voxel[k].xyz) / cascades.origin_voxel[k].w;
+    if (all(greaterThanEqual(g, vec3(0.0))) && all(lessThan(g, vec3(cascades.dims[k].xyz)))) {
+      return k;
+    }
+  }
+  return -1;
+}
+
 void main()
 {
   ivec2 low = ivec2(gl_GlobalInvocationID.xy);
@@ -27,32 +40,27 @@ void main()
   }
   vec4 p;
   ivec2 pick = pick_gbuffer_pixel(low, p);
-  float voxel = grid_origin.w;
-  vec3 g0 = (p.xyz - grid_origin.xyz) / voxel;
+  int first = (p.w < 1.0) ? -1 : cascade_of(p.xyz);
   /* Background, objects with a baked map, and points outside the region: nothing to do. */
-  if (p.w < 1.0 || any(lessThan(g0, vec3(0.0))) || any(greaterThanEqual(g0, vec3(grid_dims.xyz)))) {
+  if (first < 0) {
     imageStore(ao_low, low, vec4(1.0));
     return;
   }
   imageAtomicAdd(counters, ivec2(0), 1u);
   vec3 n = imageLoad(gbuf_normal, pick).xyz;
+  float voxel = cascades.origin_voxel[first].w;
   vec3 jit = vec3(pcg3d(uvec3(ivec3(floor(p.xyz / voxel))))) * (1.0 / 4294967296.0);
   vec3 t, s;
   tangent_frame(n, t, s);
   float sin_max = sin(spread * 1.5707963267948966);
   float sin_max2 = sin_max * sin_max;
 #ifdef MARCH_HIERARCHICAL
-  float offset = 0.0; /* rays start on the surface; the march skips the receiver's own voxels */
-#else
-  float offset = HAO_SELF_OFFSET * voxel;
-#endif
-  vec3 start = (p.xyz + n * offset - grid_origin.xyz) / voxel; /* grid units from here on */
-#ifdef MARCH_HIERARCHICAL
-  float limit = (max_distance > 0.0) ? max_distance / voxel : 1e30;
-  bool exhausted = false;
   int exhausted_rays = 0;
 #else
-  float reach = (max_distance > 0.0) ? max_distance / voxel : length(vec3(grid_dims.xyz));
+  use_cascade(first);
+  float offset = HAO_SELF_OFFSET * voxel;
+  vec3 start = (p.xyz + n * offset - cascades.origin_voxel[first].xyz) / voxel;
+  float reach = (max_distance > 0.0) ? max_distance / voxel : length(vec3(cascade_dims));
 #endif
   float occlusion = 0.0;
   for (int i = 0; i < rays; i++) {
@@ -61,14 +69,29 @@ void main()
     float r = sqrt(r2);
     vec3 dir = r * cos(phi) * t + r * sin(phi) * s + sqrt(max(1.0 - r2, 0.0)) * n;
 #ifdef MARCH_HIERARCHICAL
-    float hit = march_hierarchical(start, n, dir, limit, steps, levels, exhausted);
-    exhausted_rays += exhausted ? 1 : 0;
-    exhausted = false;
+    /* Rays start on the surface (the march skips the receiver's own voxels) and move to the
+     * next coarser cascade where they leave one, with one budget for the whole way. */
+    float hit = -1.0;
+    float travelled = 0.0;
+    int budget = steps;
+    for (int k = first; k < cascades.count.x && hit < 0.0 && budget > 0; k++) {
+      vec4 ov = cascades.origin_voxel[k];
+      use_cascade(k);
+      float limit = (max_distance > 0.0) ? max_distance / ov.w : 1e30;
+      float left;
+      float h = march_hierarchical((p.xyz - ov.xyz) / ov.w, n, dir, travelled / ov.w, limit, budget, left);
+      if (h >= 0.0) {
+        hit = h * ov.w;
+      }
+      travelled = max(travelled, left * ov.w);
+    }
+    exhausted_rays += (hit < 0.0 && budget <= 0) ? 1 : 0;
 #else
     float hit = march_fixed(start, dir, reach, steps, jit.z);
+    hit = (hit >= 0.0) ? hit * voxel + offset : -1.0;
 #endif
     if (hit >= 0.0) {
-      occlusion += hit_weight(hit * voxel + offset);
+      occlusion += hit_weight(hit);
     }
   }
 #ifdef MARCH_HIERARCHICAL

@@ -1,15 +1,9 @@
 /* One axis of the separable joint bilateral upsampling (HAO paper, equations 5 to 8); the
- * numpy reference is hao_addon/core/bilateral.py. The first pass (UPSAMPLE) reads the low
- * resolution map at y / scale, the second the first pass's full-resolution output. */
-float fetch_ao(ivec2 y)
-{
-#ifdef UPSAMPLE
-  return imageLoad(ao_src, y / scale).r;
-#else
-  return imageLoad(ao_src, y).r;
-#endif
-}
-
+ * numpy reference is hao_addon/core/hao/bilateral.py. The first pass (UPSAMPLE) weighs the
+ * AO-map samples of the blocks in its window by the position and normal of the G-buffer
+ * pixel each was computed at (low_position, low_normal: LowGBufferPass), without the AO
+ * range weight (the pixel has no AO of its own yet); the second pass filters the first
+ * pass's full-resolution output with all four weights. */
 void main()
 {
   ivec2 x = ivec2(gl_GlobalInvocationID.xy);
@@ -22,7 +16,11 @@ void main()
     return;
   }
   vec3 nx = imageLoad(gbuf_normal, x).xyz;
-  float hx = fetch_ao(x);
+#ifdef UPSAMPLE
+  float hx = imageLoad(ao_src, x / scale).r; /* kept where no sample matches */
+#else
+  float hx = imageLoad(ao_src, x).r;
+#endif
   int radius = filter_size / 2;
   ivec2 dir = (AXIS == 0) ? ivec2(1, 0) : ivec2(0, 1);
   float num = 0.0;
@@ -32,15 +30,23 @@ void main()
     if (any(lessThan(y, ivec2(0))) || any(greaterThanEqual(y, full_size))) {
       continue;
     }
+#ifdef UPSAMPLE
+    vec4 py = imageLoad(low_position, y / scale);
+    vec3 ny = imageLoad(low_normal, y / scale).xyz;
+    float hy = imageLoad(ao_src, y / scale).r;
+#else
     vec4 py = imageLoad(gbuf_position, y);
+    vec3 ny = imageLoad(gbuf_normal, y).xyz;
+    float hy = imageLoad(ao_src, y).r;
+#endif
     if (py.w < 1.0) {
       continue;
     }
-    vec3 ny = imageLoad(gbuf_normal, y).xyz;
-    float hy = fetch_ao(y);
     float wd = filter_size > 0 ? wendland(abs(float(d)), float(filter_size)) : 1.0;
-    float wt = wd * wendland(clamp(1.0 - dot(nx, ny), 0.0, 2.0), 2.0) *
-               wendland(length(px.xyz - py.xyz), max_distance) * wendland(abs(hx - hy), 1.0);
+    float wt = wd * wendland(clamp(1.0 - dot(nx, ny), 0.0, 2.0), 2.0) * wendland(length(px.xyz - py.xyz), max_distance);
+#ifndef UPSAMPLE
+    wt *= wendland(abs(hx - hy), 1.0);
+#endif
     num += wt * hy;
     den += wt;
   }

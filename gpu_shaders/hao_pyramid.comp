@@ -2,7 +2,7 @@
  * cell (x, y, z) of a level is occupied when any of the eight cells (2x + i, 2y + j, 2z + k)
  * of the level below is. Both sit in the atlas (`grid`) at their x offsets, bits along z: a
  * coarse word holds 32 coarse cells = 64 fine cells = two fine words, whose bit pairs are
- * ORed and compacted to 16 bits each. */
+ * ORed and compacted to 16 bits each. A cascade's atlas starts at row atlas_y. */
 uint compact_pairs(uint f)
 {
   uint g = (f | (f >> 1u)) & 0x55555555u;
@@ -28,11 +28,11 @@ void main()
       for (int half_word = 0; half_word < 2; half_word++) {
         int w = 2 * c.z + half_word;
         if (w < fine_words.z) {
-          uint fine = imageLoad(grid, ivec3(fine_words.w + f.x, f.y, w)).r;
+          uint fine = imageLoad(grid, ivec3(fine_words.w + f.x, f.y + atlas_y, w)).r;
           word |= compact_pairs(fine) << uint(16 * half_word);
         }
       }
     }
   }
-  imageStore(grid, ivec3(coarse_words.w + c.x, c.y, c.z), uvec4(word));
+  imageStore(grid, ivec3(coarse_words.w + c.x, c.y + atlas_y, c.z), uvec4(word));
 }

@@ -1,5 +1,6 @@
 /* Surface pass: mark the voxel of this column that holds the triangle's point (imageAtomicOr
- * into a bit-packed grid, bits along z). Solid pass: flip every voxel of the column whose
+ * into a bit-packed grid, bits along z, at y offset grid_dims.w: the cascade's place in the
+ * texture). Solid pass: flip every voxel of the column whose
  * centre lies below the triangle (parity; see hao_addon/core/voxel_grid.py). */
 void main()
 {
@@ -12,11 +13,11 @@ void main()
   int count = clamp(int(ceil(grid_pos.z - 0.5)), 0, grid_dims.z);
   int full = count >> 5;
   for (int w = 0; w < full; w++) {
-    imageAtomicXor(grid, ivec3(col, w), 0xFFFFFFFFu);
+    imageAtomicXor(grid, ivec3(col.x, col.y + grid_dims.w, w), 0xFFFFFFFFu);
   }
   int rest = count & 31;
   if (rest != 0) {
-    imageAtomicXor(grid, ivec3(col, full), (1u << uint(rest)) - 1u);
+    imageAtomicXor(grid, ivec3(col.x, col.y + grid_dims.w, full), (1u << uint(rest)) - 1u);
   }
 #else
   ivec3 v = ivec3(floor(grid_pos));
@@ -32,6 +33,6 @@ void main()
   if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, grid_dims.xyz))) {
     return;
   }
-  imageAtomicOr(grid, ivec3(v.xy, v.z >> 5), 1u << uint(v.z & 31));
+  imageAtomicOr(grid, ivec3(v.x, v.y + grid_dims.w, v.z >> 5), 1u << uint(v.z & 31));
 #endif
 }

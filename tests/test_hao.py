@@ -122,11 +122,33 @@ def test_bilateral_filter_matches_numpy_reference(renderer):
     renderer.render(objs, vp, w, h, settings)
     pos, nrm, _ = renderer.gbuffer.read()
     low = renderer.sampling.read()
-    expected = joint_bilateral_upsample(low, pos[..., :3], nrm[..., :3], pos[..., 3] >= 1.0, settings.scale,
+    from hao_addon.gpu.util import texture_to_numpy
+    low_pos, low_nrm = (texture_to_numpy(t) for t in (renderer.low_gbuffer.position, renderer.low_gbuffer.normal))
+    expected = joint_bilateral_upsample(low, low_pos[..., :3], low_nrm[..., :3], low_pos[..., 3] >= 1.0,
+                                        pos[..., :3], nrm[..., :3], pos[..., 3] >= 1.0, settings.scale,
                                         settings.filter_size, settings.max_distance)
     got = renderer.read_ao()
     assert np.abs(got - expected).max() < 1e-4
     assert np.abs(got - np.repeat(np.repeat(low, 2, 0), 2, 1)[:72, :96]).max() > 0.01  # it did filter
+
+
+def test_upsampling_weighs_each_sample_by_where_it_was_taken():
+    """A floor pixel beside an object's silhouette whose AO-map block was sampled on the
+    object (10 units nearer the camera) takes the floor's AO from its neighbours, not the
+    object's: the samples are weighed by their own positions, and its block's value does not
+    veto them through the AO range weight."""
+    h, w, k = 8, 16, 2
+    pos = np.zeros((h, w, 3))
+    pos[:, 7:, 2] = 10.0  # columns 7.. are the object; column 6 is floor in block 3 with column 7
+    nrm = np.broadcast_to([0.0, 0.0, 1.0], (h, w, 3))
+    valid = np.ones((h, w), bool)
+    low = np.where(np.arange(w // k) >= 3, 0.0, 1.0)[None, :].repeat(h // k, 0)  # block 3's pick: the object
+    low_pos = np.zeros((h // k, w // k, 3))
+    low_pos[:, 3:, 2] = 10.0
+    low_nrm = np.broadcast_to([0.0, 0.0, 1.0], (h // k, w // k, 3))
+    out = joint_bilateral_upsample(low, low_pos, low_nrm, np.ones((h // k, w // k), bool), pos, nrm, valid, k, 8, 1.0)
+    np.testing.assert_allclose(out[:, :7], 1.0)
+    np.testing.assert_allclose(out[:, 7:], 0.0)
 
 
 def ground_truth_rmse(renderer, settings, soups, rays=512):

@@ -11,11 +11,8 @@ from hao_addon.core.hao.view_settings import METHODS, ViewAOSettings
 from test_hao import view
 from test_spheres_gpu import CENTRES, RADII, _scene
 
-FRAME_INPUTS = {"geometry", "grid", "view", "spheres"}
-
-
 def test_every_method_is_a_plan_of_known_passes_in_dependency_order():
-    from hao_addon.gpu.hao_renderer import AO_MAP, PASSES, HaoRenderer
+    from hao_addon.gpu.hao_renderer import AO_MAP, FRAME_INPUTS, PASSES, HaoRenderer
     assert set(METHOD_PLANS) == set(METHODS)
     for plan in METHOD_PLANS.values():
         written = set(FRAME_INPUTS)

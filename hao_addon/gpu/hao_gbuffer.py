@@ -89,6 +89,12 @@ class GBufferPass(util.GPUPass):
                 shader.uniform_float("view_proj", np.asarray(view_proj, np.float32).T.ravel())
                 self.batch.draw(shader)
 
+    def read_depth(self, x: int, y: int, width: int, height: int) -> np.ndarray:
+        """(height, width) float32 window depths of a rectangle (1 = background)."""
+        buf = self.fb.read_depth(x, y, width, height)
+        buf.dimensions = width * height
+        return np.frombuffer(buf, np.float32).reshape(height, width).copy()
+
     def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(position (H, W, 4), normal (H, W, 4), depth (H, W)) float32 copies, row 0 bottom."""
         return (util.texture_to_numpy(self.position), util.texture_to_numpy(self.normal),

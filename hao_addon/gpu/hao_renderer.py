@@ -27,6 +27,7 @@ import gpu
 import numpy as np
 
 from ..core.errors import BakeInputError
+from ..core.hao.cascades import Focus, cascade_specs, focus_from_depth
 from ..core.hao.methods import MethodPlan, method_plan
 from ..core.hao.view_scene import SceneObject, render_anchor, scene_bounds
 from ..core.hao.view_settings import ViewAOSettings
@@ -39,11 +40,13 @@ from .near_field import run_near_field
 from .sphere_far import FarSpheresPass
 
 AO_MAP = "ao_map"  # the low-resolution AO map, written in place by a method's AO passes
+# What a frame's passes read besides each other (HaoRenderer._frame_inputs).
+FRAME_INPUTS = ("geometry", "region", "grid", "view", "spheres")
 
 
 @dataclass(frozen=True)
 class PassSpec:
-    """reads: frame inputs (geometry, grid, view, spheres) and resources (a pass name, or
+    """reads: FRAME_INPUTS and resources (a pass name, or
     AO_MAP) whose keys its key includes; settings: ViewAOSettings fields it depends on;
     writes: the resource it leaves (its own name, or AO_MAP); stat: its counter in stats."""
     reads: tuple[str, ...]
@@ -54,9 +57,12 @@ class PassSpec:
 
 PASSES = {
     "upload": PassSpec(("geometry",), (), "upload"),
-    # Not the upload: the grid's key names the objects reaching into it (one changing outside
-    # a user region is uploaded again, not voxelized again).
-    "voxelize": PassSpec(("grid",), (), "voxelize"),
+    # Where the cascades go (core/hao/cascades.py): its key for the passes after it is the
+    # placement it chose, which a small camera move leaves unchanged.
+    "cascades": PassSpec(("gbuffer", "region"), ("grid", "cascades", "march"), "cascades"),
+    # Not the upload: the grid's key names the cascades and the objects reaching into each
+    # (one changing outside a user region, or outside a cascade, is not voxelized again).
+    "voxelize": PassSpec(("cascades", "grid"), (), "voxelize"),
     "gbuffer": PassSpec(("upload", "view"), (), "gbuffer"),
     "back_layer": PassSpec(("upload", "view"), (), "back_layer"),
     "low_gbuffer": PassSpec(("gbuffer",), ("scale",), "low_gbuffer"),
@@ -65,7 +71,7 @@ PASSES = {
     "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance"), "near", AO_MAP),
     "open_ao": PassSpec(("gbuffer",), ("scale",), "open_ao", AO_MAP),
     "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres"), ("epsilon",), "far", AO_MAP),
-    "filter": PassSpec((AO_MAP, "grid"), ("filter_size", "max_distance"), "filter"),
+    "filter": PassSpec((AO_MAP, "low_gbuffer", "region"), ("filter_size", "max_distance"), "filter"),
 }
 
 
@@ -94,6 +100,7 @@ class Frame:
     height: int
     settings: ViewAOSettings
     spheres: tuple[np.ndarray, np.ndarray] | None
+    inputs: dict | None = None
 
 
 class HaoRenderer(util.GPUPass):
@@ -108,9 +115,12 @@ class HaoRenderer(util.GPUPass):
         self.low_gbuffer = LowGBufferPass()  # G-buffer at the AO-map resolution, for the spheres
         self.stats: Counter = Counter()
         self._state: dict[str, object] = {}  # resource -> key of what it holds now
+        self._outputs: dict[str, object] = {}  # resource -> the key later passes see of it
         self._boxes_key: object = None
         self._boxes: list = []
-        self.spec: GridSpec | None = None
+        self.spec: GridSpec | None = None  # the region's grid (the coarsest cascade)
+        self.cascade_specs: tuple[GridSpec, ...] = ()  # finest first
+        self.focus: Focus | None = None
         self.anchor = np.zeros(3)  # world point the GPU passes' positions are relative to
 
     def render(self, objects: list[SceneObject], view_proj: np.ndarray, width: int, height: int,
@@ -157,13 +167,21 @@ class HaoRenderer(util.GPUPass):
         # origin); G-buffer positions read back are relative to it (self.anchor).
         anchor = render_anchor(*(world_bounds if world_bounds is not None else bounds))
         self.anchor = anchor
-        self.spec = grid_for_bounds(np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor, settings.grid)
-        # Only objects reaching into the region can change the grid: one moving outside a
-        # user region re-renders the G-buffer but is not re-voxelized.
-        lo = np.asarray(self.spec.origin) + anchor
-        hi = lo + np.asarray(self.spec.dims) * self.spec.voxel
-        inside = tuple(k for o, k, box in zip(objects, geometry_key, self._boxes)
-                       if box is not None and o in voxelized and _boxes_overlap(*box, lo, hi))
+        self.region = (np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor)
+        self.spec = grid_for_bounds(*self.region, settings.grid)
+        voxel_boxes = [(k, box) for o, k, box in zip(objects, geometry_key, self._boxes)
+                       if box is not None and o in voxelized]
+
+        def grid_key():
+            """Per cascade, the objects reaching into it (read once the cascades are placed):
+            one moving outside every cascade re-renders the G-buffer but is not voxelized."""
+            per_cascade = []
+            for spec in self.cascade_specs:
+                lo = np.asarray(spec.origin) + anchor
+                hi = lo + np.asarray(spec.dims) * spec.voxel
+                per_cascade.append(tuple(k for k, box in voxel_boxes if _boxes_overlap(*box, lo, hi)))
+            return tuple(per_cascade), settings.march
+
         shift = np.identity(4)
         shift[:3, 3] = anchor
         view_proj = np.asarray(view_proj, np.float64) @ shift  # anchor-relative -> clip
@@ -171,7 +189,8 @@ class HaoRenderer(util.GPUPass):
             spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
         inputs = {
             "geometry": (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes()),
-            "grid": (inside, self.spec, anchor.tobytes(), settings.march),
+            "region": (self.spec, anchor.tobytes()),
+            "grid": grid_key,
             "view": (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height),
             "spheres": ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes())
                         if spheres is not None else None),
@@ -179,18 +198,27 @@ class HaoRenderer(util.GPUPass):
         return inputs, Frame(objects, voxelized, view_proj, width, height, settings, spheres)
 
     def _sequence(self, plan: MethodPlan, inputs: dict, frame: Frame) -> None:
-        """Run the plan's passes whose resource does not hold their key yet."""
+        """Run the plan's passes whose resource does not hold their key yet. An input may be
+        a function, read when a pass first needs it (after the passes before it ran); a
+        runner may return the key the passes after it see of its resource (else its key)."""
         keys = dict(inputs)
+        frame.inputs = keys  # runners read the inputs their keys were made of
+
+        def read(name):
+            if callable(keys.get(name)):
+                keys[name] = keys[name]()
+            return keys.get(name)
+
         for name in plan.passes:
             spec = PASSES[name]
-            key = (name, tuple(keys.get(r) for r in spec.reads),
-                   tuple(getattr(frame.settings, f) for f in spec.settings))
+            key = (name, tuple(read(r) for r in spec.reads), tuple(getattr(frame.settings, f) for f in spec.settings))
             resource = spec.writes or name
             if self._state.get(resource) != key:
-                getattr(self, "_run_" + name)(frame)
+                output = getattr(self, "_run_" + name)(frame)
                 self._state[resource] = key
+                self._outputs[resource] = key if output is None else output
                 self.stats[spec.stat] += 1
-            keys[resource] = key
+            keys[resource] = self._outputs.get(resource, key)
 
     # The passes (PASSES): each runs unconditionally; the sequencer decides when.
 
@@ -214,11 +242,28 @@ class HaoRenderer(util.GPUPass):
         self.gbuffer.set_geometry(pos, nrm, flags)
         self.back.set_geometry(pos, nrm, flags)
 
+    def _run_cascades(self, frame: Frame):
+        """Place the cascades around the focus of the G-buffer (the paper's fixed march
+        keeps one grid); returns the placement."""
+        settings = frame.settings
+        count = settings.cascades if settings.march == "hierarchical" else 1
+        self.focus = self._focus(frame) if count > 1 else None
+        self.cascade_specs = cascade_specs(*self.region, settings.grid, count, self.focus)
+        return self.cascade_specs
+
+    def _focus(self, frame: Frame) -> Focus | None:
+        """The focus from the G-buffer's depth in the central half of the image."""
+        w, h = frame.width, frame.height
+        depth = self.gbuffer.read_depth(w // 4, h // 4, max(w // 2, 1), max(h // 2, 1))
+        return focus_from_depth(depth, np.linalg.inv(frame.view_proj), (w, h))
+
     def _run_voxelize(self, frame: Frame) -> None:
         # Closed objects are filled only for the paper's march, which steps over shells; the
         # hierarchical march visits every voxel, and a fill would darken what a scan's holes
         # leak it into (the floor under the Stanford bunny's open base).
-        self.voxels.voxelize(self.spec, solids=frame.settings.march == "fixed")
+        per_cascade, march = frame.inputs["grid"]
+        self.stats["cascades_voxelized"] += self.voxels.voxelize(self.cascade_specs, solids=march == "fixed",
+                                                                 keys=per_cascade)
 
     def _run_gbuffer(self, frame: Frame) -> None:
         self.gbuffer.render(frame.view_proj, frame.width, frame.height)
@@ -229,7 +274,7 @@ class HaoRenderer(util.GPUPass):
     def _run_low_gbuffer(self, frame: Frame) -> None:
         self.low_gbuffer.run(self.gbuffer, frame.settings.scale)
 
-    def _run_voxel_ao(self, frame: Frame) -> None:
+    def _run_voxel_ao(self, frame: Frame) -> None:  # noqa: D102 - the cascades' march
         self.sampling.run(self.gbuffer, self.voxels, frame.settings)
 
     def _run_near_field(self, frame: Frame) -> None:
@@ -246,7 +291,8 @@ class HaoRenderer(util.GPUPass):
         self.far.run(self.low_gbuffer, self.sampling.ao_low, centres, radii, frame.settings.epsilon, frame.view_proj)
 
     def _run_filter(self, frame: Frame) -> None:
-        self.filter.run(self.gbuffer, self.sampling.ao_low, frame.settings, filter_range(frame.settings, self.spec))
+        self.filter.run(self.gbuffer, self.low_gbuffer, self.sampling.ao_low, frame.settings,
+                        filter_range(frame.settings, self.spec))
 
     @property
     def ao_texture(self) -> "gpu.types.GPUTexture":

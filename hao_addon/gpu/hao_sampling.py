@@ -6,12 +6,31 @@ import gpu
 import numpy as np
 
 from ..core.hao.ao_pattern import GLSL_DEFINES
+from ..core.hao.cascades import MAX_CASCADES
+from ..core.hao.voxel_grid import level_count
 from ..core.hao.view_settings import ViewAOSettings
 from . import util
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import add_defines, cached_shader, glsl_source
 
 GROUP = 8
+
+
+# The HaoCascades uniform block (gpu_shaders/hao_cascades.glsl, std140: arrays of vec4 and
+# ivec4 need no padding).
+CASCADES_DTYPE = np.dtype([("origin_voxel", "<f4", (MAX_CASCADES, 4)), ("dims", "<i4", (MAX_CASCADES, 4)),
+                           ("atlas", "<i4", (MAX_CASCADES, 4)), ("count", "<i4", (4,))])
+
+
+def cascades_block(specs, rows) -> np.ndarray:
+    """The HaoCascades block of the cascades' grids (finest first) at their texture rows."""
+    block = np.zeros(1, CASCADES_DTYPE)
+    for k, (spec, row) in enumerate(zip(specs, rows)):
+        block["origin_voxel"][0, k] = (*spec.origin, spec.voxel)
+        block["dims"][0, k] = (*spec.dims, level_count(spec.dims))
+        block["atlas"][0, k, 0] = row
+    block["count"][0, 0] = len(specs)
+    return block
 
 
 # Cells are looked up this far (voxels) past each boundary a hierarchical march crosses:
@@ -28,13 +47,13 @@ def _ao_info(march: str, falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     if falloff == "wendland":
         info.define("WENDLAND_FALLOFF", "1")
     info.define("MARCH_NUDGE", repr(MARCH_NUDGE))
-    info.push_constant('VEC4', "grid_origin")
-    info.push_constant('IVEC4', "grid_dims")
+    info.define("MAX_CASCADES", str(MAX_CASCADES))
+    info.typedef_source(glsl_source("hao_cascades.glsl"))
+    info.uniform_buf(0, "HaoCascades", "cascades")
     info.push_constant('IVEC2', "full_size")
     info.push_constant('INT', "scale")
     info.push_constant('INT', "rays")
     info.push_constant('INT', "steps")
-    info.push_constant('INT', "levels")
     info.push_constant('FLOAT', "spread")
     info.push_constant('FLOAT', "max_distance")
     declare_gbuffer_images(info)
@@ -59,6 +78,9 @@ def _bilateral_info(axis: int, upsample: bool) -> "gpu.types.GPUShaderCreateInfo
     declare_gbuffer_images(info)
     info.image(2, 'R32F', 'FLOAT_2D', "ao_src", qualifiers={'READ'})
     info.image(3, 'R32F', 'FLOAT_2D', "ao_dst", qualifiers={'WRITE'})
+    if upsample:
+        info.image(4, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'READ'})
+        info.image(5, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'READ'})
     info.compute_source(glsl_source("hao_common.glsl", "hao_bilateral.comp"))
     return info
 
@@ -129,6 +151,7 @@ class AOSamplingPass(util.GPUPass):
         self.ao_low = None
         self.low_size = (0, 0)
         self.counter = None
+        self.cascades_block = None
 
     def _ensure(self, gbuffer, k: int) -> tuple[int, int]:
         width, height = gbuffer.size
@@ -152,16 +175,18 @@ class AOSamplingPass(util.GPUPass):
         if self.counter is None:
             self.counter = gpu.types.GPUTexture((2, 1), format='R32UI')
         self.counter.clear(format='UINT', value=(0,))
-        spec = voxels.spec
+        block = cascades_block(voxels.specs, voxels.y_offsets)
+        if self.cascades_block is None:
+            self.cascades_block = gpu.types.GPUUniformBuf(block.view(np.float32))
+        else:
+            self.cascades_block.update(block.view(np.float32))
         shader = ao_shader(settings.march, settings.falloff)
         shader.bind()
-        shader.uniform_float("grid_origin", (*spec.origin, spec.voxel))
-        shader.uniform_int("grid_dims", (*spec.dims, 0))
+        shader.uniform_block("cascades", self.cascades_block)
         shader.uniform_int("full_size", (width, height))
         shader.uniform_int("scale", k)
         shader.uniform_int("rays", settings.rays)
         shader.uniform_int("steps", settings.steps)
-        _set_optional(shader, "levels", voxels.levels, integer=True)
         shader.uniform_float("spread", settings.spread)
         shader.uniform_float("max_distance", settings.max_distance)
         bind_gbuffer_images(shader, gbuffer)
@@ -185,7 +210,7 @@ class AOSamplingPass(util.GPUPass):
         return self.counts()[0]
 
     def _release(self) -> None:
-        self.ao_low = self.counter = None
+        self.ao_low = self.counter = self.cascades_block = None
         self.low_size = (0, 0)
 
 
@@ -197,8 +222,9 @@ class BilateralPass(util.GPUPass):
         self.middle = self.ao = None
         self.size = (0, 0)
 
-    def run(self, gbuffer, ao_low, settings: ViewAOSettings, position_range: float) -> None:
-        """position_range: the distance at which the position weight w_p reaches 0."""
+    def run(self, gbuffer, low_gbuffer, ao_low, settings: ViewAOSettings, position_range: float) -> None:
+        """low_gbuffer: the samples of the AO map (LowGBufferPass); position_range: the
+        distance at which the position weight w_p reaches 0."""
         width, height = gbuffer.size
         if self.size != (width, height):
             self.middle = gpu.types.GPUTexture((width, height), format='R32F')
@@ -214,6 +240,9 @@ class BilateralPass(util.GPUPass):
             bind_gbuffer_images(shader, gbuffer)
             shader.image("ao_src", src)
             shader.image("ao_dst", dst)
+            if axis == 0:
+                shader.image("low_position", low_gbuffer.position)
+                shader.image("low_normal", low_gbuffer.normal)
             gpu.compute.dispatch(shader, -(-width // GROUP), -(-height // GROUP), 1)
         gpu.shader.unbind()
 

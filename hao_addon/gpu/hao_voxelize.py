@@ -8,6 +8,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.hao.cascades import atlas_layout
 from ..core.hao.voxel_grid import GridSpec, atlas_words, level_count, level_dims, level_offsets
 from . import util
 from .shaders import cached_shader, glsl_source
@@ -43,6 +44,7 @@ def _unpack_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(0, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ'})
     info.image(1, 'R32UI', 'UINT_2D', "flat_words", qualifiers={'WRITE'})
     info.push_constant('IVEC4', "grid_dims")
+    info.push_constant('INT', "atlas_y")
     info.compute_source("""
 void main()
 {
@@ -50,7 +52,7 @@ void main()
   if (any(greaterThanEqual(c, grid_dims.xyz))) {
     return;
   }
-  imageStore(flat_words, ivec2(c.x, c.y + c.z * grid_dims.y), imageLoad(grid, c + ivec3(grid_dims.w, 0, 0)));
+  imageStore(flat_words, ivec2(c.x, c.y + c.z * grid_dims.y), imageLoad(grid, c + ivec3(grid_dims.w, atlas_y, 0)));
 }
 """)
     return info
@@ -62,7 +64,25 @@ def _pyramid_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(0, 'R32UI', 'UINT_3D', "grid", qualifiers={'READ', 'WRITE'})
     info.push_constant('IVEC4', "fine_words")  # x cells, y cells, z words, atlas x offset
     info.push_constant('IVEC4', "coarse_words")
+    info.push_constant('INT', "atlas_y")  # the cascade's y offset in the texture
     info.compute_source(glsl_source("hao_pyramid.comp"))
+    return info
+
+
+def _clear_info() -> "gpu.types.GPUShaderCreateInfo":
+    info = gpu.types.GPUShaderCreateInfo()
+    info.local_group_size(8, 8, 1)
+    info.image(0, 'R32UI', 'UINT_3D', "grid", qualifiers={'WRITE'})
+    info.push_constant('IVEC4', "box")  # x size, y first, y end, z size
+    info.compute_source("""
+void main()
+{
+  ivec3 c = ivec3(gl_GlobalInvocationID.xyz) + ivec3(0, box.y, 0);
+  if (c.x < box.x && c.y < box.z && c.z < box.w) {
+    imageStore(grid, c, uvec4(0u));
+  }
+}
+""")
     return info
 
 
@@ -72,20 +92,35 @@ def _level_words(dims: tuple[int, int, int], level: int) -> tuple[int, int, int,
 
 
 class VoxelPass(util.GPUPass):
-    """Owns the triangle batches of the scene and the voxel grid."""
+    """Owns the triangle batch of the scene and the cascades' voxel grids with their
+    pyramids, in one texture (cascades.atlas_layout)."""
 
     def __init__(self) -> None:
         super().__init__()
         self.surface_batch = self.solid_batch = None
         self.grid = None
-        self.spec: GridSpec | None = None
-        self.levels = 1
+        self.specs: tuple[GridSpec, ...] = ()
+        self.y_offsets: list[int] = []
+        self._contents: list = []  # per cascade: the key of what it holds
+        self.object_boxes: list[tuple[int, int, np.ndarray, np.ndarray]] = []
         self.triangles = 0
         self._plane, self._plane_fb, self._plane_side = None, None, 0
+        self.voxelized_cascades = 0  # cascades (re)voxelized so far
 
-    def set_geometry(self, positions: np.ndarray, axes: np.ndarray, solid: np.ndarray) -> None:
+    @property
+    def spec(self) -> GridSpec | None:
+        """The finest cascade's grid (the only one with a single cascade)."""
+        return self.specs[0] if self.specs else None
+
+    @property
+    def levels(self) -> int:
+        return level_count(self.spec.dims) if self.spec else 1
+
+    def set_geometry(self, positions: np.ndarray, axes: np.ndarray, solid: np.ndarray,
+                     object_faces: list[int] | None = None) -> None:
         """positions: (F, 3, 3) world; axes: (F,) dominant axis; solid: (F,) bool, triangles
-        of closed objects that also go into the solid (parity) pass."""
+        of closed objects that also go into the solid (parity) pass; object_faces: the face
+        count of each object, in order (cascades draw only the objects reaching into them)."""
         pos = positions.reshape(-1, 3)
         axis = np.repeat(np.asarray(axes, np.float32), 3)
         self.triangles = len(positions)
@@ -93,21 +128,62 @@ class VoxelPass(util.GPUPass):
         sp = positions[np.asarray(solid, bool)].reshape(-1, 3)
         self.solid_batch = (util.make_batch('TRIS', {"pos": ('F32', sp), "axis": ('F32', np.zeros(len(sp)))})
                             if len(sp) else None)
+        counts = [len(positions)] if object_faces is None else list(object_faces)
+        ends = np.cumsum(counts).astype(int)
+        self.object_boxes = []
+        for first, end in zip(np.concatenate([[0], ends[:-1]]).astype(int), ends):
+            flat = positions[first:end].reshape(-1, 3)
+            if len(flat):
+                self.object_boxes.append((int(first), int(end), flat.min(0), flat.max(0)))
+        self._contents = []
 
-    def voxelize(self, spec: GridSpec, solids: bool = True) -> None:
-        """Voxelize the geometry into a grid of spec (solids: the closed objects filled, see
-        core/hao/voxel_grid.py), then build its pyramid."""
-        words = atlas_words(spec.dims)
-        if self.grid is None or self.spec is None or atlas_words(self.spec.dims) != words:
-            self.grid = gpu.types.GPUTexture(words, format='R32UI')
-        self.spec = spec
-        self.levels = level_count(spec.dims)
-        self.grid.clear(format='UINT', value=(0,))
+    def voxelize(self, spec: "GridSpec | tuple[GridSpec, ...]", solids: bool = True,
+                 keys: tuple | None = None) -> int:
+        """Voxelize the geometry into the cascades' grids (finest first; one GridSpec: one
+        grid) and build their pyramids. solids: closed objects filled (core/hao/voxel_grid.py,
+        one grid only). keys: per cascade, what reaches into it (None: redo every cascade);
+        a cascade whose grid and key are unchanged keeps its voxels. Returns how many
+        cascades were voxelized."""
+        specs = (spec,) if isinstance(spec, GridSpec) else tuple(spec)
+        keys = tuple(keys) if keys is not None else (None,) * len(specs)
+        size, offsets = atlas_layout(specs)
+        if self.grid is None or tuple(self.grid_size) != size:
+            self.grid = gpu.types.GPUTexture(size, format='R32UI')
+            self.grid.clear(format='UINT', value=(0,))
+            self._contents = []
+        self.grid_size = size
+        contents = [(s, y, k) for s, y, k in zip(specs, offsets, keys)]
+        redo = [i for i, c in enumerate(contents)
+                if c[2] is None or i >= len(self._contents) or self._contents[i] != c]
+        self.specs, self.y_offsets = specs, offsets
+        for i in redo:
+            self._clear_cascade(i)
+            self._draw_cascade(i, solids and len(specs) == 1)
+            self._build_pyramid(i)
+        self._contents = contents
+        self.voxelized_cascades += len(redo)
+        return len(redo)
+
+    def _clear_cascade(self, i: int) -> None:
+        words = atlas_words(self.specs[i].dims)
+        shader = cached_shader(("hao_clear_box",), _clear_info)
+        shader.bind()
+        shader.image("grid", self.grid)
+        shader.uniform_int("box", (words[0], self.y_offsets[i], self.y_offsets[i] + words[1], words[2]))
+        gpu.compute.dispatch(shader, -(-words[0] // 8), -(-words[1] // 8), words[2])
+        gpu.shader.unbind()
+
+    def _draw_cascade(self, i: int, solids: bool) -> None:
+        spec = self.specs[i]
         side = max(spec.dims)
-        if self._plane_side != side:  # the colour target only sizes the raster plane
+        if self._plane_side < side:  # the colour target only sizes the raster plane
             self._plane = gpu.types.GPUTexture((side, side), format='R8')  # kept alive with its framebuffer
             self._plane_fb = gpu.types.GPUFrameBuffer(color_slots=self._plane)
             self._plane_side = side
+        lo = np.asarray(spec.origin)
+        hi = lo + np.asarray(spec.dims) * spec.voxel
+        runs = [(first, end) for first, end, blo, bhi in self.object_boxes
+                if (blo <= hi).all() and (bhi >= lo).all()]
         with util.scoped_state(), self._plane_fb.bind():
             util.set_overlay_pass_state(side, side)
             # Parity first, then the surface ORed over it: XOR and OR do not commute.
@@ -119,40 +195,49 @@ class VoxelPass(util.GPUPass):
                 shader = voxelize_shader(solid)
                 shader.bind()
                 shader.uniform_float("grid_origin", (*spec.origin, spec.voxel))
-                shader.uniform_int("grid_dims", (*spec.dims, 0))
+                shader.uniform_int("grid_dims", (*spec.dims, self.y_offsets[i]))
                 shader.uniform_float("plane_size", size)
                 shader.image("grid", self.grid)
-                batch.draw(shader)
+                if solid or not hasattr(batch, "draw_range"):
+                    batch.draw(shader)
+                else:  # only the objects reaching into this cascade
+                    for first, end in runs:
+                        batch.draw_range(shader, elem_start=3 * first, elem_count=3 * (end - first))
                 util.image_barrier()
-        self._build_pyramid()
 
-    def _build_pyramid(self) -> None:
+    def _build_pyramid(self, i: int) -> None:
+        dims = self.specs[i].dims
         shader = cached_shader(("hao_pyramid",), _pyramid_info)
         shader.bind()
         shader.image("grid", self.grid)
-        for level in range(1, self.levels):
-            coarse = _level_words(self.spec.dims, level)
-            shader.uniform_int("fine_words", _level_words(self.spec.dims, level - 1))
+        shader.uniform_int("atlas_y", self.y_offsets[i])
+        for level in range(1, level_count(dims)):
+            coarse = _level_words(dims, level)
+            shader.uniform_int("fine_words", _level_words(dims, level - 1))
             shader.uniform_int("coarse_words", coarse)
             gpu.compute.dispatch(shader, -(-coarse[0] // 4), -(-coarse[1] // 4), -(-coarse[2] // 4))
         gpu.shader.unbind()
 
-    def read_grid(self, level: int = 0) -> np.ndarray:
-        """(nz, ny, nx) bool copy of a level of the pyramid, 0 the grid (for tests; a compute
-        copy into 2D, since GPUTexture.read() returns only the first slice of a 3D texture)."""
-        nx, ny, nw, x0 = _level_words(self.spec.dims, level)
+    def read_grid(self, level: int = 0, cascade: int = 0) -> np.ndarray:
+        """(nz, ny, nx) bool copy of a level of a cascade's pyramid, 0 the grid (for tests; a
+        compute copy into 2D, since GPUTexture.read() returns only the first slice of a 3D
+        texture)."""
+        dims = self.specs[cascade].dims
+        nx, ny, nw, x0 = _level_words(dims, level)
         flat = gpu.types.GPUTexture((nx, ny * nw), format='R32UI')
         shader = cached_shader(("hao_unpack",), _unpack_info)
         shader.bind()
         shader.uniform_int("grid_dims", (nx, ny, nw, x0))
+        shader.uniform_int("atlas_y", self.y_offsets[cascade])
         shader.image("grid", self.grid)
         shader.image("flat_words", flat)
         gpu.compute.dispatch(shader, -(-nx // 8), -(-ny // 8), nw)
         gpu.shader.unbind()
         words = util.texture_to_numpy(flat, np.uint32).reshape(nw, ny, nx)
         from ..core.hao.voxel_grid import unpack_bits
-        return unpack_bits(words)[:level_dims(self.spec.dims, level)[2]]
+        return unpack_bits(words)[:level_dims(dims, level)[2]]
 
     def _release(self) -> None:
         self.surface_batch = self.solid_batch = self.grid = None
+        self._contents = []
         self._plane, self._plane_fb, self._plane_side = None, None, 0

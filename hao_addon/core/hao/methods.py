@@ -5,9 +5,11 @@ pass and what each one reads; a method is nothing but this list, so a new method
 way to combine two, is a new row here and at most a new pass there.
 
 Pass names (what each computes is documented with its runner in the renderer):
-upload, voxelize, gbuffer, back_layer, low_gbuffer: scene buffers;
+upload, gbuffer, back_layer, low_gbuffer: scene buffers; cascades, voxelize: where the voxel
+grids go (around the G-buffer's focus) and their voxels;
 voxel_ao, near_field, open_ao: start the AO map (voxel march, image-space near field, all 1);
-spheres: multiply the sphere proxies' occlusion into it; filter: bilateral upsampling.
+spheres: multiply the sphere proxies' occlusion into it; filter: bilateral upsampling (weighing
+the AO map's samples by low_gbuffer, the G-buffer pixels they were computed at).
 """
 from __future__ import annotations
 
@@ -30,11 +32,12 @@ class MethodPlan:
 
 
 METHOD_PLANS = {plan.name: plan for plan in (
-    MethodPlan("hao", ("upload", "voxelize", "gbuffer", "voxel_ao", "filter")),
+    MethodPlan("hao", ("upload", "gbuffer", "cascades", "voxelize", "voxel_ao", "low_gbuffer", "filter")),
     MethodPlan("far", ("upload", "gbuffer", "open_ao", "low_gbuffer", "spheres", "filter"), spheres=True),
-    MethodPlan("hao+far", ("upload", "voxelize", "gbuffer", "voxel_ao", "low_gbuffer", "spheres", "filter"),
+    MethodPlan("hao+far", ("upload", "gbuffer", "cascades", "voxelize", "voxel_ao", "low_gbuffer", "spheres",
+                           "filter"),
                voxels="unproxied", spheres=True),
-    MethodPlan("near", ("upload", "gbuffer", "back_layer", "near_field", "filter")),
+    MethodPlan("near", ("upload", "gbuffer", "back_layer", "near_field", "low_gbuffer", "filter")),
     MethodPlan("near+far", ("upload", "gbuffer", "back_layer", "near_field", "low_gbuffer", "spheres", "filter"),
                spheres=True),
 )}

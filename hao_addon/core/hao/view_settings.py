@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from .cascades import MAX_CASCADES
 from .methods import method_plan
 from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
@@ -34,7 +35,8 @@ MARCH_CHOICES = (
     Choice("fixed", "Fixed Steps", "the paper's march: Steps samples spaced d_max / Steps apart, which can step "
                                    "over walls thinner than that"),
 )
-DEFAULT_STEPS = 64
+DEFAULT_STEPS = 128
+DEFAULT_CASCADES = 4
 
 
 @dataclass(frozen=True)
@@ -56,7 +58,11 @@ class ViewAOSettings:
     falloff: str = setting("wendland", label="Falloff", choices=FALLOFF_CHOICES,
                            description="how occlusion fades with distance (only with a max distance)")
     grid: int = setting(256, label="Grid", minimum=GRID_MIN, maximum=GRID_MAX, unit="voxels",
-                        description="voxels along the longest side of the region of interest")
+                        description="voxels along the longest side of the region of interest (and of each cascade)")
+    cascades: int = setting(DEFAULT_CASCADES, label="Cascades", minimum=1, maximum=MAX_CASCADES,
+                            description="nested grids, each with half the voxel size of the one around it, placed "
+                                        "around what the view looks at while they cover it (1 = one grid over the "
+                                        "region; the fixed march uses one)")
     scale: int = setting(2, label="AO Scale", noun="scale", minimum=1, maximum=8,
                          description="AO is sampled at 1/scale of the image resolution per axis, then "
                                      "upsampled by the bilateral filter")
