@@ -135,7 +135,7 @@ class VoxelPass(util.GPUPass):
             flat = positions[first:end].reshape(-1, 3)
             if len(flat):
                 self.object_boxes.append((int(first), int(end), flat.min(0), flat.max(0)))
-        self._contents = []
+        # The cascades keep their voxels: each one's key names the objects in it.
 
     def voxelize(self, spec: "GridSpec | tuple[GridSpec, ...]", solids: bool = True,
                  keys: tuple | None = None) -> int:
