@@ -113,12 +113,18 @@ def test_bad_input_messages(addon, gpu_context):
 
 
 def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
-    """The walk at three frames, camera on the character: AO at the G-buffer points of the
-    character against a ray-traced reference of that frame's deformed mesh and the floor
-    (Wendland kernel, d_max 0.3). Measured RMSE at frames 3 / 19 / 35: voxels 0.050 / 0.033 /
-    0.060; 64 spheres 0.106 / 0.118 / 0.156; spheres for the character with voxels for the
-    floor 0.103 / 0.109 / 0.148. The bounds guard these numbers (spheres are a coarse stand-in
-    for a body: arms and legs lie partly inside their own proxies)."""
+    """The walk at three frames, camera on the character: every method's AO at the G-buffer
+    points of the character against a ray-traced reference of that frame's deformed mesh and
+    the floor, with the same kernel (Wendland, d_max 0.5; and unlimited). Voxels are the most
+    accurate method; the combinations count each occluder once (near+far: the near field
+    within Near Radius, the spheres beyond it; hao+far: voxels for the whole region, so the
+    spheres add nothing here), so neither is worse than the better of its parts, within the
+    reference's noise (128 stratified rays: RMSE below 0.005 on these points). Measured RMSE
+    on the man (frames 3 / 19 / 35; 80 x 60 AO samples, so these are the hard points: creases
+    between limbs and body a few voxels wide) at d_max 0.5: hao 0.049 / 0.034 / 0.048, far
+    0.054 / 0.084 / 0.085, near 0.112 / 0.082 / 0.142, near+far 0.042 / 0.055 / 0.057;
+    unlimited: hao 0.028 / 0.030 / 0.032, far 0.278 / 0.303 / 0.270 (the spheres stand in for
+    the character only, not the floor under it), near+far 0.275 / 0.297 / 0.265."""
     from hao_ext.hao_addon.blender import sphere_proxies as sp
     from hao_ext.hao_addon.blender.view_scene import visible_scene_objects
     from hao_ext.hao_addon.gpu.hao_renderer import HaoRenderer
@@ -129,6 +135,7 @@ def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
     w, h = 160, 120
     vp = cm.perspective(0.7, w / h, 0.05, 50.0) @ cm.look_at((1.6, -2.2, 1.3), (0.0, 0.0, 0.7))
     renderer = HaoRenderer()
+    methods = ("hao", "far", "near", "near+far", "hao+far")
     results = {}
     try:
         for frame in (3, 19, 35):
@@ -139,20 +146,26 @@ def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
             for o in objects:
                 o.proxied = o.name in proxied
             tris = np.concatenate([o.world_positions() for o in objects])
-            for method in ("hao", "far", "hao+far"):
-                settings = ViewAOSettings(method=method, rays=64, max_distance=0.3, grid=256, filter_size=0)
-                renderer.render(objects, vp, w, h, settings, spheres=spheres)
-                pts, nrm, ao = low_res_samples(renderer, settings)
-                on_man = pts[:, 2] > 0.02
-                pick = np.flatnonzero(on_man)[::3]
-                gt = reference_accessibility(pts[pick], nrm[pick], tris, rays=128, max_distance=0.3,
-                                             falloff="wendland", seed=frame)
-                results.setdefault(method, []).append(float(np.sqrt(((ao[pick] - gt) ** 2).mean())))
+            for d_max in (0.5, 0.0):
+                truth = None
+                for method in methods:
+                    settings = ViewAOSettings(method=method, rays=64, max_distance=d_max, grid=256, filter_size=0)
+                    renderer.render(objects, vp, w, h, settings, spheres=spheres)
+                    pts, nrm, ao = low_res_samples(renderer, settings)
+                    if truth is None:
+                        pick = np.flatnonzero(pts[:, 2] > 0.02)[::2]  # on the man
+                        truth = reference_accessibility(pts[pick], nrm[pick], tris, rays=128, max_distance=d_max,
+                                                        falloff="wendland", seed=frame)
+                    results.setdefault((method, d_max), []).append(float(np.sqrt(((ao[pick] - truth) ** 2).mean())))
     finally:
         renderer.free()
-    assert max(results["hao"]) < 0.07
-    assert max(results["far"]) < 0.17 and max(results["hao+far"]) < 0.16
-    assert all(a < b for a, b in zip(results["hao"], results["far"]))
+    noise = 0.005
+    for d_max in (0.5, 0.0):
+        r = {m: np.array(results[(m, d_max)]) for m in methods}
+        assert r["hao"].max() <= 0.055 and (r["hao"] < r["far"]).all() and (r["hao"] < r["near"]).all(), r
+        assert (r["near+far"] <= np.minimum(r["near"], r["far"]) + noise).all(), r
+        assert (r["hao+far"] <= np.minimum(r["hao"], r["far"]) + noise).all(), r
+    assert np.array(results[("near+far", 0.5)]).max() < 0.065
 
 
 def test_render_ao_methods_on_the_command_line(tmp_path):

@@ -29,7 +29,8 @@ def test_far_pass_equals_numpy_reference(renderer):
     vp, w, h = view((2.2, -2.6, 2.4), target=(0.0, 0.0, 0.2))
     renderer.render(objs, vp, w, h, settings, spheres=(CENTRES, RADII))
     pts, nrm, ao = low_res_samples(renderer, settings)
-    ref = spheres_accessibility(pts, nrm, CENTRES, RADII, settings.epsilon, "multiply")
+    ref = spheres_accessibility(pts, nrm, CENTRES, RADII, settings.epsilon, "multiply", settings.max_distance,
+                                settings.falloff)
     assert np.abs(ao - ref).max() < 1e-4
     assert ao.min() < 0.5 and renderer.far.stats["spheres_drawn"] == 5
     # Spheres off screen are culled before drawing.
@@ -43,7 +44,7 @@ def test_multiplicative_combination_is_closer_to_ground_truth(renderer):
     the spheres' AO combined by the paper's clamped sum and by the product. Measured: sum
     RMSE 0.053 (over-occlusion where spheres overlap), product 0.037."""
     objs, soups = _scene()
-    settings = ViewAOSettings(method="far", epsilon=0.005, filter_size=0)
+    settings = ViewAOSettings(method="far", epsilon=0.005, filter_size=0, max_distance=0.0)
     vp, w, h = view((0.01, -0.01, 4.5), target=(0.0, 0.0, 0.0), width=128, height=128)
     renderer.render(objs, vp, w, h, settings, spheres=(CENTRES, RADII))
     pts, nrm, ao = low_res_samples(renderer, settings)
@@ -73,8 +74,8 @@ def test_near_field_pass_equals_numpy_mirror(renderer):
     ly, lx = np.mgrid[0:low.shape[0], 0:low.shape[1]]
     picks = np.stack([np.minimum(lx * 2 + 1, w - 1), np.minimum(ly * 2 + 1, h - 1)], -1).reshape(-1, 2)
     valid = front[0][picks[:, 1], picks[:, 0], 3] >= 1.0
-    ref = near_field_reference(front[0], front[1], back[0], back[1], picks[valid], vp, settings.max_distance,
-                               settings.rays)
+    ref = near_field_reference(front[0], front[1], back[0], back[1], picks[valid], vp, settings.near_field_radius(),
+                               settings.rays, settings.max_distance, settings.falloff)
     got = low.reshape(-1)[valid]
     diff = np.abs(got - ref)
     # float32 against float64: a sample rounding to the neighbouring pixel changes one term.
@@ -89,7 +90,7 @@ def test_near_field_sphere_on_plane_against_analytic(renderer):
     (measured RMSE 0.13 at M = 64, 0.065 at 256, 0.037 at 1024), over a systematic +0.017
     (patches seen at grazing angles from the camera are counted with at most 5x a pixel's
     area). Bounds at M = 1024: RMSE 0.05, |bias| 0.025."""
-    settings = ViewAOSettings(method="near", rays=1024, max_distance=1.5, filter_size=0)
+    settings = ViewAOSettings(method="near", rays=1024, max_distance=1.5, falloff="none", filter_size=0)
     vp, w, h = view((0.0, -3.0, 1.0), target=(0.0, 0.0, 0.2), width=240, height=180, fov=1.0)
     renderer.render(_sphere_on_plane(), vp, w, h, settings)
     pts, nrm, ao = low_res_samples(renderer, settings)

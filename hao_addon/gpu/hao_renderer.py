@@ -68,9 +68,11 @@ PASSES = {
     "low_gbuffer": PassSpec(("gbuffer",), ("scale",), "low_gbuffer"),
     "voxel_ao": PassSpec(("gbuffer", "voxelize"), ("scale", "rays", "steps", "march", "spread", "max_distance",
                                                    "falloff"), "ao", AO_MAP),
-    "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance"), "near", AO_MAP),
+    "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance", "falloff", "near_radius",
+                                                       "method"), "near", AO_MAP),
     "open_ao": PassSpec(("gbuffer",), ("scale",), "open_ao", AO_MAP),
-    "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres"), ("epsilon",), "far", AO_MAP),
+    "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres", "region"), ("epsilon", "max_distance", "falloff",
+                                                                       "near_radius", "method"), "far", AO_MAP),
     "filter": PassSpec((AO_MAP, "low_gbuffer", "region"), ("filter_size", "max_distance"), "filter"),
 }
 
@@ -154,7 +156,7 @@ class HaoRenderer(util.GPUPass):
 
     def _frame_inputs(self, plan: MethodPlan, objects, view_proj, width, height, settings, region, spheres):
         """(the frame inputs' keys, the Frame): geometry, grid, view and spheres."""
-        voxelized = [o for o in objects if not (plan.voxels == "unproxied" and o.proxied)]
+        voxelized = list(objects)
         geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
         if self._boxes_key != geometry_key:  # object boxes are a pass over every triangle
             self._boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
@@ -186,7 +188,11 @@ class HaoRenderer(util.GPUPass):
         shift[:3, 3] = anchor
         view_proj = np.asarray(view_proj, np.float64) @ shift  # anchor-relative -> clip
         if spheres is not None:
-            spheres = (np.asarray(spheres[0], np.float64) - anchor, spheres[1])
+            spheres = (np.asarray(spheres[0], np.float64) - anchor, np.asarray(spheres[1], np.float64))
+            if plan.sphere_scope == "outside":  # the voxels hold what is inside the region
+                lo, hi = self.region
+                outside = ~np.all((spheres[0] >= lo) & (spheres[0] <= hi), axis=1)
+                spheres = (spheres[0][outside], spheres[1][outside])
         inputs = {
             "geometry": (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes()),
             "region": (self.spec, anchor.tobytes()),
@@ -238,7 +244,7 @@ class HaoRenderer(util.GPUPass):
         vpos = relative(voxelized)
         solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
                  else np.zeros(0, bool))
-        self.voxels.set_geometry(vpos, dominant_axes(vpos), solid)
+        self.voxels.set_geometry(vpos, dominant_axes(vpos), solid, [len(o.positions) for o in voxelized])
         self.gbuffer.set_geometry(pos, nrm, flags)
         self.back.set_geometry(pos, nrm, flags)
 
@@ -281,14 +287,17 @@ class HaoRenderer(util.GPUPass):
         settings = frame.settings
         self.sampling.clear(self.gbuffer, settings.scale)
         run_near_field(self.gbuffer, self.back, self.sampling.ao_low, settings.scale, frame.view_proj,
-                       settings.max_distance, settings.rays)
+                       settings.near_field_radius(), settings.rays, settings.max_distance, settings.falloff)
 
     def _run_open_ao(self, frame: Frame) -> None:
         self.sampling.clear(self.gbuffer, frame.settings.scale)
 
     def _run_spheres(self, frame: Frame) -> None:
         centres, radii = frame.spheres
-        self.far.run(self.low_gbuffer, self.sampling.ao_low, centres, radii, frame.settings.epsilon, frame.view_proj)
+        settings = frame.settings
+        near_radius = settings.near_field_radius() if "near_field" in method_plan(settings.method).passes else 0.0
+        self.far.run(self.low_gbuffer, self.sampling.ao_low, centres, radii, settings.epsilon, frame.view_proj,
+                     settings.max_distance, settings.falloff, near_radius)
 
     def _run_filter(self, frame: Frame) -> None:
         self.filter.run(self.gbuffer, self.low_gbuffer, self.sampling.ao_low, frame.settings,

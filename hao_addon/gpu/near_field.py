@@ -13,8 +13,11 @@ from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
 from .shaders import add_defines, cached_shader, glsl_source
 
 
-def _near_info() -> "gpu.types.GPUShaderCreateInfo":
+def _near_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     info = gpu.types.GPUShaderCreateInfo()
+    if falloff == "wendland":
+        info.define("WENDLAND_FALLOFF", "1")
+    info.push_constant('FLOAT', "max_distance")
     info.local_group_size(GROUP, GROUP, 1)
     info.push_constant('IVEC2', "full_size")
     info.push_constant('INT', "scale")
@@ -32,17 +35,20 @@ def _near_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
-def near_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("hao_near_field",), _near_info)
+def near_shader(falloff: str = "wendland") -> "gpu.types.GPUShader":
+    return cached_shader(("hao_near_field", falloff), lambda: _near_info(falloff))
 
 
-def run_near_field(front, back, ao_low, scale: int, view_proj: np.ndarray, r_far: float, samples: int) -> None:
+def run_near_field(front, back, ao_low, scale: int, view_proj: np.ndarray, r_far: float, samples: int,
+                   max_distance: float = 0.0, falloff: str = "wendland") -> None:
     """Write near-field accessibility into ao_low (R32F, the AO-map resolution) from the front
-    and back-layer G-buffer passes."""
+    and back-layer G-buffer passes: samples within r_far, each weighted by the AO's distance
+    falloff (max_distance 0 = unlimited)."""
     row3, proj_scale, eye = camera_terms(view_proj)
     width, height = front.size
-    shader = near_shader()
+    shader = near_shader(falloff)
     shader.bind()
+    shader.uniform_float("max_distance", max_distance)
     shader.uniform_int("full_size", (width, height))
     shader.uniform_int("scale", scale)
     shader.uniform_int("samples", samples)

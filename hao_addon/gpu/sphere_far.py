@@ -16,7 +16,7 @@ from . import util
 from .shaders import cached_shader, glsl_source
 
 
-def _far_info() -> "gpu.types.GPUShaderCreateInfo":
+def _far_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     iface = gpu.types.GPUStageInterfaceInfo("hao_sphere_far_iface")
     iface.flat('VEC4', "sphere_data")
     iface.flat('FLOAT', "sphere_reach")
@@ -28,13 +28,17 @@ def _far_info() -> "gpu.types.GPUShaderCreateInfo":
     info.image(0, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'READ'})
     info.fragment_out(0, 'VEC4', "far_out")
+    info.push_constant('FLOAT', "max_distance")
+    info.push_constant('FLOAT', "near_radius")
+    if falloff == "wendland":
+        info.define("WENDLAND_FALLOFF", "1")
     info.vertex_source(glsl_source("sphere_far.vert"))
-    info.fragment_source(glsl_source("sphere_far.frag"))
+    info.fragment_source(glsl_source("hao_common.glsl", "sphere_far.frag"))
     return info
 
 
-def far_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("hao_sphere_far",), _far_info)
+def far_shader(falloff: str = "wendland") -> "gpu.types.GPUShader":
+    return cached_shader(("hao_sphere_far", falloff), lambda: _far_info(falloff))
 
 
 def billboard_rectangles(centres: np.ndarray, reach: np.ndarray, view_proj: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -80,10 +84,12 @@ class FarSpheresPass(util.GPUPass):
         self._fb = self._fb_target = None
 
     def run(self, low_gbuffer, ao_map, centres: np.ndarray, radii: np.ndarray, epsilon: float,
-            view_proj: np.ndarray) -> None:
+            view_proj: np.ndarray, max_distance: float = 0.0, falloff: str = "wendland",
+            near_radius: float = 0.0) -> None:
         """low_gbuffer: the G-buffer at the AO-map resolution (LowGBufferPass); ao_map: R32F
         texture of that size, already holding an accessibility (1s for spheres alone, or the
-        HAO result to combine with)."""
+        result to combine with); max_distance, falloff, near_radius: see
+        core/proxies/sphere_ao.sphere_weight."""
         centres = np.asarray(centres, np.float64).reshape(-1, 3)
         radii = np.asarray(radii, np.float64).reshape(-1)
         reach = far_distance(radii, epsilon)
@@ -102,8 +108,10 @@ class FarSpheresPass(util.GPUPass):
             self._fb, self._fb_target = gpu.types.GPUFrameBuffer(color_slots=ao_map), ao_map
         with util.scoped_state(), self._fb.bind():
             util.set_overlay_pass_state(ao_map.width, ao_map.height, blend='MULTIPLY')
-            shader = far_shader()
+            shader = far_shader(falloff)
             shader.bind()
+            shader.uniform_float("max_distance", max_distance)
+            shader.uniform_float("near_radius", near_radius)
             shader.image("low_position", low_gbuffer.position)
             shader.image("low_normal", low_gbuffer.normal)
             batch.draw(shader)

@@ -18,13 +18,13 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class MethodPlan:
-    """passes: run in this order; voxels: which objects the voxel grid holds ('all', or
-    'unproxied': those without sphere proxies, which the spheres stand in for); spheres:
-    whether the method needs sphere proxies."""
+    """passes: run in this order; spheres: whether the method needs sphere proxies;
+    sphere_scope: which of them occlude: 'all', or 'outside' the region of interest (the
+    voxels hold everything inside it, so each occluder is counted once)."""
     name: str
     passes: tuple[str, ...]
-    voxels: str = "all"
     spheres: bool = False
+    sphere_scope: str = "all"
 
     @property
     def voxelizes(self) -> bool:
@@ -35,8 +35,7 @@ METHOD_PLANS = {plan.name: plan for plan in (
     MethodPlan("hao", ("upload", "gbuffer", "cascades", "voxelize", "voxel_ao", "low_gbuffer", "filter")),
     MethodPlan("far", ("upload", "gbuffer", "open_ao", "low_gbuffer", "spheres", "filter"), spheres=True),
     MethodPlan("hao+far", ("upload", "gbuffer", "cascades", "voxelize", "voxel_ao", "low_gbuffer", "spheres",
-                           "filter"),
-               voxels="unproxied", spheres=True),
+                           "filter"), sphere_scope="outside", spheres=True),
     MethodPlan("near", ("upload", "gbuffer", "back_layer", "near_field", "low_gbuffer", "filter")),
     MethodPlan("near+far", ("upload", "gbuffer", "back_layer", "near_field", "low_gbuffer", "spheres", "filter"),
                spheres=True),

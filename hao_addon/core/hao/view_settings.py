@@ -22,11 +22,12 @@ MAX_RENDER_SIDE = 65536
 METHOD_CHOICES = (
     Choice("hao", "HAO Voxels", "voxel ray-marching against everything (static and deforming)"),
     Choice("far", "Sphere Proxies", "only the sphere proxies of characters (fast, coarse)"),
-    Choice("hao+far", "Voxels + Spheres", "spheres for meshes that have proxies, voxels for the rest "
-                                          "(each occluder counted once)"),
+    Choice("hao+far", "Voxels + Spheres", "voxels for everything in the region of interest, sphere proxies "
+                                          "for characters outside it (each occluder counted once)"),
     Choice("near", "Near Field", "image-space AO from the two depth layers within the distance "
                                  "(rays = samples per pixel); misses what is off screen"),
-    Choice("near+far", "Near Field + Spheres", "near field plus the sphere proxies (the paper's combination)"),
+    Choice("near+far", "Near Field + Spheres", "the paper's combination: near field within Near Radius, sphere "
+                                               "proxies beyond it (each occluder counted once)"),
 )
 METHODS = tuple(c.value for c in METHOD_CHOICES)
 MARCH_CHOICES = (
@@ -71,6 +72,11 @@ class ViewAOSettings:
     strength: float = setting(1.0, label="Strength", minimum=0.0, maximum=1.0, subtype='FACTOR', cli=None,
                               description="how much the viewport is darkened (1 = the computed AO)")
     method: str = setting("hao", label="Method", choices=METHOD_CHOICES, description="what casts the AO")
+    near_radius: float = setting(0.075, label="Near Radius", minimum=0.0, above_minimum=True, soft_max=10.0,
+                                 unit="scene units", subtype='DISTANCE',
+                                 description="near field + spheres: the near field covers occluders within this "
+                                             "distance, the sphere proxies those beyond it, so none is counted "
+                                             "twice; the near field alone covers d_max (this at unlimited distance)")
     epsilon: float = setting(0.05, label="Sphere Cut-off", noun="epsilon", minimum=0.0, above_minimum=True,
                              maximum=0.99, description="occlusion below which a sphere proxy stops influencing "
                                                        "(the paper's epsilon): smaller reaches farther")
@@ -82,6 +88,13 @@ class ViewAOSettings:
 
     def with_(self, **changes) -> "ViewAOSettings":
         return replace(self, **changes)
+
+    def near_field_radius(self) -> float:
+        """The distance the near field samples within: its share with the spheres (near+far),
+        else d_max, or near_radius at unlimited distance."""
+        if self.method == "near+far":
+            return min(self.near_radius, self.max_distance) if self.max_distance > 0.0 else self.near_radius
+        return self.max_distance if self.max_distance > 0.0 else self.near_radius
 
 
 # GPU bytes per full-resolution pixel: a G-buffer layer (RGBA32F position and normal, 32-bit

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels import occlusion_weight
+
 from ..hao.ao_pattern import GOLDEN_FRACTION, pcg3d
 
 
@@ -41,9 +43,12 @@ def camera_terms(view_proj: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
 
 
 def near_field_reference(front_pos: np.ndarray, front_nrm: np.ndarray, back_pos: np.ndarray, back_nrm: np.ndarray,
-                         picks: np.ndarray, view_proj: np.ndarray, r_far: float, samples: int) -> np.ndarray:
+                         picks: np.ndarray, view_proj: np.ndarray, r_far: float, samples: int,
+                         max_distance: float = 0.0, falloff: str = "wendland") -> np.ndarray:
     """Accessibility at the G-buffer pixels `picks` ((n, 2) integer x, y). G-buffers: (H, W, 4)
-    position (w: coverage) and normal arrays, row 0 at the bottom, as the GPU pass reads them."""
+    position (w: coverage) and normal arrays, row 0 at the bottom, as the GPU pass reads them.
+    r_far: the radius sampled; each sample's occlusion is weighted by the AO's distance
+    falloff (kernels.occlusion_weight with max_distance, 0 = unlimited) at its distance."""
     row3, proj_scale, eye = camera_terms(view_proj)
     h, w = front_pos.shape[:2]
     px, py = picks[:, 0], picks[:, 1]
@@ -81,5 +86,7 @@ def near_field_reference(front_pos: np.ndarray, front_nrm: np.ndarray, back_pos:
             sin_t = np.minimum(r / np.maximum(dist, np.maximum(r, 1e-300)), 1.0)
             solid_angle = 2.0 * np.pi * (1.0 - np.sqrt(np.maximum(1.0 - sin_t ** 2, 0.0)))
             cos_a = np.maximum((n * pc).sum(1) / np.maximum(dist, 1e-12), 0.0)
-            occ += weight * np.where(ok, np.where(dist > 0.0, np.minimum(solid_angle * cos_a / np.pi, 1.0), 1.0), 0.0)
+            falloff_w = occlusion_weight(d, max_distance, falloff)
+            occ += weight * falloff_w * np.where(ok, np.where(dist > 0.0, np.minimum(solid_angle * cos_a / np.pi, 1.0),
+                                                              1.0), 0.0)
     return 1.0 - np.minimum(occ, 1.0)

@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels import occlusion_weight
+
 
 def far_distance(radius: np.ndarray, epsilon: float) -> np.ndarray:
     """d_far of equation 5 for sphere radii (any shape); epsilon in (0, 2 pi)."""
@@ -45,18 +47,37 @@ def sphere_occlusion(points: np.ndarray, normals: np.ndarray, centre: np.ndarray
     return np.where(dist > 0.0, np.minimum(solid_angle * cos_a / np.pi, 1.0), 1.0)
 
 
+def sphere_weight(distance: np.ndarray, radius: float, max_distance: float, falloff: str,
+                  near_radius: float) -> np.ndarray:
+    """What a sphere's occlusion counts at receivers `distance` from its centre (GLSL twin in
+    sphere_far.frag): the distance falloff of the AO (kernels.occlusion_weight) at the
+    distance halfway into the sphere, max(distance - radius / 2, 0), where most of its
+    directions hit; and, with a near field covering occluders within near_radius (near+far),
+    only the share of the sphere beyond that radius, clamp((distance + radius - near_radius)
+    / (2 radius), 0, 1), so no occluder is counted by both."""
+    d = np.asarray(distance, np.float64)
+    w = occlusion_weight(np.maximum(d - 0.5 * radius, 0.0), max_distance, falloff)
+    if near_radius > 0.0:
+        w = w * np.clip((d + radius - near_radius) / (2.0 * max(radius, 1e-30)), 0.0, 1.0)
+    return w
+
+
 def spheres_accessibility(points: np.ndarray, normals: np.ndarray, centres: np.ndarray, radii: np.ndarray,
-                          epsilon: float, combine: str = "multiply") -> np.ndarray:
-    """Accessibility (n,) under K spheres (K, 3), (K,), each cut off beyond its d_far.
-    combine: 'add' (the paper: 1 - min(sum, 1)) or 'multiply' (prod (1 - occlusion_i),
-    occluders treated as independent, which avoids the over-occlusion of overlapping ones)."""
+                          epsilon: float, combine: str = "multiply", max_distance: float = 0.0,
+                          falloff: str = "wendland", near_radius: float = 0.0) -> np.ndarray:
+    """Accessibility (n,) under K spheres (K, 3), (K,), each cut off beyond its d_far and
+    weighted by sphere_weight. combine: 'add' (the paper: 1 - min(sum, 1)) or 'multiply'
+    (prod (1 - occlusion_i), occluders treated as independent, which avoids the
+    over-occlusion of overlapping ones)."""
     points = np.asarray(points, np.float64)
     reach = far_distance(radii, epsilon)
     total = np.zeros(len(points)) if combine == "add" else np.ones(len(points))
     for c, r, d in zip(np.asarray(centres, np.float64), np.asarray(radii, np.float64), reach):
-        near = np.linalg.norm(points - c, axis=1) <= d
+        dist = np.linalg.norm(points - c, axis=1)
+        near = dist <= d
         occ = np.zeros(len(points))
-        occ[near] = sphere_occlusion(points[near], normals[near], c, r)
+        occ[near] = sphere_occlusion(points[near], normals[near], c, r) * sphere_weight(dist[near], r, max_distance,
+                                                                                         falloff, near_radius)
         if combine == "add":
             total += occ
         elif combine == "multiply":
