@@ -97,10 +97,18 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         props = context.scene.hao_view
         col = layout.column()
         col.prop(props, "rays")
+        col.prop(props, "march")
         col.prop(props, "steps")
         col.prop(props, "spread")
-        col.prop(props, "max_distance")
+        col.prop(props, "unlimited")
+        sub = col.column()
+        sub.active = not props.unlimited
+        sub.prop(props, "max_distance")
+        sub.prop(props, "falloff")
         col.prop(props, "grid")
+        sub = col.column()
+        sub.active = props.march == "hierarchical"
+        sub.prop(props, "cascades")
         col.prop(props, "scale")
         col.prop(props, "filter_size")
         col.prop(props, "strength")
@@ -113,6 +121,9 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         col.prop(props, "skip_baked")
         col.separator()
         col.prop(props, "method")
+        sub = col.column()
+        sub.active = props.method == "near+far"
+        sub.prop(props, "near_radius")
         col.prop(props, "epsilon")
         col.prop(props, "show_spheres")
         row = layout.row(align=True)

@@ -37,8 +37,14 @@ class HAO_PG_view_settings(bpy.types.PropertyGroup):
                                                "no HAO of their own (the paper's static regions)",
         default=False, update=_redraw)
 
+    unlimited: BoolProperty(
+        name="Unlimited", description="Every occluder counts, however far (what Cycles' AO and the bake compute); "
+                                      "the same as Distance 0, without losing the distance set",
+        default=False, update=_redraw)
+
     def to_settings(self) -> ViewAOSettings:
-        return settings_from(self, ViewAOSettings)
+        settings = settings_from(self, ViewAOSettings)
+        return settings.with_(max_distance=0.0) if self.unlimited else settings
 
 
 # Rays, steps, distance, grid, ... from the core's ViewAOSettings (one definition each).

@@ -198,6 +198,12 @@ def test_render_operator_and_overlay_registration(addon, gpu_context, tmp_path):
     scene = bpy.context.scene
     scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 120, 90, 100
     scene.hao_view.rays, scene.hao_view.grid = 8, 64
+    # The panel's Unlimited toggle: distance 0 while on, the distance set kept for when it is off.
+    scene.hao_view.max_distance = 0.75  # exact in float32
+    scene.hao_view.unlimited = True
+    assert scene.hao_view.to_settings().max_distance == 0.0 and scene.hao_view.max_distance == 0.75
+    scene.hao_view.unlimited = False
+    assert scene.hao_view.to_settings().max_distance == 0.75
     out = tmp_path / "op.exr"
     assert bpy.ops.render.hao_render_ao(filepath=str(out)) == {'FINISHED'}
     img = bpy.data.images["HAO Render"]
