@@ -250,9 +250,9 @@ def objects_of(soups):
     return _OBJECTS[key]
 
 
-def character_objects(frame: int, floor: float):
+def character_objects(frame: int, floor: float, k: int = 64):
     """The walking CesiumMan at a frame on a floor `floor` units wide (a Blender scene with
-    the bench's character camera), its SceneObjects and sphere proxies (64)."""
+    the bench's character camera), its SceneObjects and its k sphere proxies."""
     from hao_addon.blender import sphere_proxies as sp
     from hao_addon.blender.view_scene import clear_cache, visible_scene_objects
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -260,7 +260,7 @@ def character_objects(frame: int, floor: float):
     bpy.data.objects["Icosphere"].hide_set(True)
     bpy.ops.mesh.primitive_plane_add(size=floor)
     man = bpy.data.objects["Cesium_Man"]
-    sp.make_proxies(man, 64)
+    sp.make_proxies(man, k)
     bpy.context.scene.frame_set(frame)
     scene_camera(CHARACTER_CAMERA)
     dg = bpy.context.evaluated_depsgraph_get()

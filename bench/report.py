@@ -26,30 +26,53 @@ def time_at_rmse(runs: list[dict], rmse: float) -> float | None:
 
 def hao_tables(res: dict) -> str:
     st = res["settings"]
-    lines = [f"Frame {st['width']}x{st['height']}, AO map 1/{st['scale']}, {st['rays']} rays, {st['steps']} steps, "
-             f"{st['grid']}^3 grid, filter {st['filter_size']}, d_max {st['max_distance']} (median ms):\n",
-             "| scene | triangles | voxelize | G-buffer | AO | filter | composite | frame | Workbench (AA off) | frame / Workbench |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    for name, sc in res["scenes"].items():
-        p = sc["passes_ms"]
-        lines.append(f"| {name} | {sc['triangles']:,} | {p['voxelize']:.1f} | {p['gbuffer']:.1f} | {p['ao']:.1f} | "
-                     f"{p['filter']:.1f} | {p['composite']:.1f} | {p['frame']:.1f} | {sc['workbench_ms']:.1f} | "
-                     f"{sc['frame_over_workbench']:.2f}x |")
-    lines.append(f"\nAO passes (sampling + filter), 1M-triangle torus over bunny: "
-                 f"{res['ao_passes_1M_over_bunny']:.2f}x.\n")
-    for name, err in res["error"].items():
-        lines.append(f"Error, {name} ({err['points']} visible pixels, reference {err['reference_rays']} rays):\n")
-        lines.append("| variant | frame ms | AO passes ms | RMSE |")
-        lines.append("|---|---:|---:|---:|")
-        for r in err["runs"]:
-            lines.append(f"| {r['label']} | {r['frame_ms']:.1f} | {r['ao_passes_ms']:.1f} | {r['rmse']:.4f} |")
+    lines = []
+    if "frame" in res:
+        lines.append(f"Frame {st['width']}x{st['height']}, AO map 1/{st['scale']}, {st['rays']} rays, {st['grid']}^3 "
+                     f"grid, filter {st['filter_size']}, d_max {st['max_distance']}; hierarchical march (budget "
+                     f"{st['steps']} steps) and the paper's 8 fixed steps (median ms):\n")
+        passes = ("voxelize", "gbuffer", "ao", "low_gbuffer", "filter", "composite")
+        lines.append("| scene | triangles | " + " | ".join(passes) + " | frame | Workbench (AA off) | frame / Workbench "
+                     "| paper march frame | paper / Workbench |")
+        lines.append("|---|---:|" + "---:|" * (len(passes) + 5))
+        for name, m in res["frame"].items():
+            h = m["hao"]
+            lines.append(f"| {name} | {m['triangles']:,} | " + " | ".join(f"{h[p]:.1f}" for p in passes)
+                         + f" | {h['frame']:.1f} | {m['workbench_ms']:.1f} | {m['hao_over_workbench']:.2f}x | "
+                           f"{m['paper']['frame']:.1f} | {m['paper_over_workbench']:.2f}x |")
+        lines.append(f"\nAO passes (sampling + filter), 1M-triangle torus over bunny: {res['ao_passes_1M_over_bunny']:.2f}x.\n")
+    if "distances" in res:
+        lines.append(f"RMSE against ray-traced truth at {st['points']:,} visible pixels ({st['reference_rays']} rays, "
+                     f"same kernel and d_max), HAO (frame ms, cascades) / the paper's march / EEVEE's AO node "
+                     f"({st['eevee_samples']} samples):\n")
+        factors = [r["factor"] for r in next(iter(res["distances"].values()))["rows"]]
+        head = [f"{f:g} x height" if f else "unlimited" for f in factors]
+        lines.append("| scene | " + " | ".join(head) + " |")
+        lines.append("|---|" + "---|" * len(head))
+        for name, m in res["distances"].items():
+            cells = [f"**{r['hao']['rmse']:.4f}** ({r['hao']['frame_ms']:.0f}, {r['hao']['cascades']}) / "
+                     f"{r['paper']['rmse']:.4f} / {r['eevee']['rmse']:.4f}" for r in m["rows"]]
+            lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
-    for param, rows in res["sweeps"].items():
+    if "character_methods" in res:
+        lines.append("Character methods (CesiumMan on the 4-unit floor), RMSE over the visible pixels / on the man:\n")
+        methods = ("hao", "far", "near", "near+far", "hao+far")
+        lines.append("| frame | d_max | " + " | ".join(methods) + " |")
+        lines.append("|---:|---|" + "---|" * len(methods))
+        for frame, rows in res["character_methods"].items():
+            for d, got in rows.items():
+                label = "unlimited" if float(d) == 0.0 else d
+                lines.append(f"| {frame} | {label} | " + " | ".join(
+                    f"{got['visible'][m]['rmse']:.4f} / {got['man'][m]['rmse']:.4f}" for m in methods) + " |")
+        lines.append("")
+    for param, rows in res.get("sweeps", {}).items():
         lines.append(f"Sweep of {param} (bunny): " + ", ".join(f"{r['value']}: {r['frame']:.0f} ms" for r in rows) + "\n")
-    lines.append("Cost against triangle count (torus on a floor): " + ", ".join(
-        f"{r['triangles']:,}: vox {r['voxelize']:.0f} / G-buf {r['gbuffer']:.0f} / AO+filter {r['ao_passes']:.0f} ms"
-        for r in res["triangles"]) + "\n")
-    lines.append(f"Machine: {res['machine']['platform']}; Blender {res['machine']['blender']}; {res['machine']['gpu']}.")
+    if res.get("triangles"):
+        lines.append("Cost against triangle count (torus on a floor): " + ", ".join(
+            f"{r['triangles']:,}: vox {r['voxelize']:.0f} / G-buf {r['gbuffer']:.0f} / AO+filter {r['ao_passes']:.0f} ms"
+            for r in res["triangles"]) + "\n")
+    m = res["machine"]
+    lines.append(f"Machine: {m['platform']}; Blender {m['blender']}; {m['gpu']}.")
     return "\n".join(lines)
 
 
@@ -82,7 +105,7 @@ def spheres_tables(res: dict) -> str:
 def main() -> int:
     path = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parent / "results" / "bake_bench.json")
     res = json.loads(path.read_text())
-    if "scenes" in res:
+    if "frame" in res or "distances" in res:
         print(hao_tables(res))
         return 0
     if "sync_numpy" in res:

@@ -147,22 +147,9 @@ def frame_passes(renderer, objects, vp, spheres, repeats):
 
 
 def character_scene(frame, k):
-    from hao_addon.blender import sphere_proxies as sp
-    from hao_addon.blender.view_scene import clear_cache, visible_scene_objects
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_scene.gltf(filepath=str(ROOT / "tests" / "data" / "CesiumMan.glb"))
-    bpy.data.objects["Icosphere"].hide_set(True)
-    bpy.ops.mesh.primitive_plane_add(size=4.0)
-    man = bpy.data.objects["Cesium_Man"]
-    sp.make_proxies(man, k)
-    bpy.context.scene.frame_set(frame)
-    dg = bpy.context.evaluated_depsgraph_get()
-    clear_cache()
-    objects = visible_scene_objects(dg, bpy.context.view_layer)
-    spheres, proxied = sp.scene_spheres(bpy.context.view_layer, dg)
-    for o in objects:
-        o.proxied = o.name in proxied
-    return objects, spheres
+    """The walking CesiumMan on a 4-unit floor with K sphere proxies (hao_bench.character_objects)."""
+    from hao_bench import character_objects
+    return character_objects(frame, 4.0, k)
 
 
 def method_errors(renderer, objects, spheres, vp, methods, points, rays, seed, receivers=None, max_distance=0.3):
