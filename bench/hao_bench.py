@@ -358,7 +358,11 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true", help="fewer repeats and points (smoke test)")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
     ap.add_argument("--parts", default="frame,distances,character,sweeps,triangles")
+    ap.add_argument("--plot-only", action="store_true", help="redraw hao_bench.png from hao_bench.json")
     args = ap.parse_args()
+    if args.plot_only:
+        plot(json.loads((Path(args.out) / "hao_bench.json").read_text()), Path(args.out) / "hao_bench.png")
+        return 0
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     parts = args.parts.split(",")
@@ -473,17 +477,17 @@ def plot(results, path) -> None:
             ax.set_title("Accuracy at every distance (solid HAO, dotted paper march, dashed EEVEE)")
             ax.legend(fontsize=6)
         elif panel == "character_methods":
-            for d, style in (("0.5", "o-"), ("0", "s--")):
-                for frame, rows in results["character_methods"].items():
-                    got = rows[d]["visible"]
-                    ax.plot([got[m]["frame_ms"] for m in CHARACTER_METHODS], [got[m]["rmse"] for m in CHARACTER_METHODS],
-                            style, alpha=0.6)
-                    for m in CHARACTER_METHODS:
-                        ax.annotate(m, (got[m]["frame_ms"], got[m]["rmse"]), fontsize=6)
+            for d, marker in (("0.5", "o"), ("0", "s")):
+                for i, m in enumerate(CHARACTER_METHODS):
+                    rows = [r[d]["visible"][m] for r in results["character_methods"].values()]
+                    ax.scatter([r["frame_ms"] for r in rows], [r["rmse"] for r in rows], marker=marker, color=f"C{i}",
+                               label=m if d == "0.5" else None, alpha=0.8)
+            ax.axhline(0.03, color="gray", ls="--", lw=0.8)
             ax.set_yscale("log")
             ax.set_xlabel("frame ms")
             ax.set_ylabel("RMSE (visible pixels)")
-            ax.set_title("Character methods, d_max 0.5 (solid) and unlimited (dashed)")
+            ax.set_title("Character methods: d_max 0.5 (circles), unlimited (squares)")
+            ax.legend(fontsize=7)
         else:
             tr = results["triangles"]
             for p in PASSES:
