@@ -266,9 +266,7 @@ def character_objects(frame: int, floor: float, k: int = 64):
     dg = bpy.context.evaluated_depsgraph_get()
     clear_cache()
     objects = visible_scene_objects(dg, bpy.context.view_layer)
-    spheres, proxied = sp.scene_spheres(bpy.context.view_layer, dg)
-    for o in objects:
-        o.proxied = o.name in proxied
+    spheres, _ = sp.scene_spheres(bpy.context.view_layer, dg)
     return objects, spheres
 
 

@@ -34,10 +34,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)
     if not objects:
         raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects")
-    spheres, proxied = (scene_spheres(view_layer, depsgraph) if method_plan(settings.method).spheres
-                        else (None, set()))
-    for obj in objects:
-        obj.proxied = obj.name in proxied
+    spheres = scene_spheres(view_layer, depsgraph)[0] if method_plan(settings.method).spheres else None
     view_proj = camera_view_projection(camera, depsgraph, width, height)
     own = renderer is None
     renderer = renderer or HaoRenderer()

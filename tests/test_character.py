@@ -142,9 +142,7 @@ def test_character_ao_per_frame_against_ray_traced_mesh(addon, gpu_context):
             bpy.context.scene.frame_set(frame)
             dg = bpy.context.evaluated_depsgraph_get()
             objects = visible_scene_objects(dg, bpy.context.view_layer)
-            spheres, proxied = sp.scene_spheres(bpy.context.view_layer, dg)
-            for o in objects:
-                o.proxied = o.name in proxied
+            spheres, _ = sp.scene_spheres(bpy.context.view_layer, dg)
             tris = np.concatenate([o.world_positions() for o in objects])
             for d_max in (0.5, 0.0):
                 truth = None

@@ -32,8 +32,6 @@ def test_switching_methods_reruns_what_the_other_method_changed(renderer, other)
     multiply into it): after a frame of another method, the same 'hao' frame as before is
     rendered, not the other method's leftovers."""
     objs, _ = _scene()
-    for o in objs[1:3]:
-        o.proxied = True
     settings = ViewAOSettings(rays=8, grid=64)
     vp, w, h = view((2.2, -2.6, 2.4), target=(0.0, 0.0, 0.2))
     spheres = (CENTRES, RADII)

@@ -66,10 +66,8 @@ class ViewportSession:
         objects = self.scene_objects(context, getattr(context.scene.hao_view, "skip_baked", False))
         if not objects:
             return None
-        spheres, proxied = (scene_spheres(context.view_layer, context.evaluated_depsgraph_get())
-                            if method_plan(settings.method).spheres else (None, set()))
-        for obj in objects:
-            obj.proxied = obj.name in proxied
+        spheres = (scene_spheres(context.view_layer, context.evaluated_depsgraph_get())[0]
+                   if method_plan(settings.method).spheres else None)
         region = context.region
         renderer = self.renderer_for(region.as_pointer(), open_view_regions(context.window_manager))
         renderer.render(objects, np.array(context.region_data.perspective_matrix), region.width, region.height,

@@ -6,7 +6,7 @@ headless render (hao_addon/render_ao.py).
 Each pass is a row of PASSES: what it reads (frame inputs and resources other passes wrote),
 the settings it depends on, the resource it writes. Its key is made of those; it runs only
 when the resource it writes does not already hold that key, so the skips are (counted in
-`stats`, shown by tests/test_hao_skip.py):
+`stats`, shown by tests/test_hao_scene.py and test_hao_cascades.py):
 - geometry upload only when an object's key (geometry or transform) or the set of objects
   changed; voxelization only when that happened to an object reaching into the region of
   interest, or the region or the grid resolution changed;
@@ -96,7 +96,6 @@ def _boxes_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo: np.ndarray, hi: np.nd
 class Frame:
     """One render call's inputs, anchor-relative (see render_anchor)."""
     objects: list[SceneObject]
-    voxelized: list[SceneObject]
     view_proj: np.ndarray  # (4, 4) anchor-relative -> clip
     width: int
     height: int
@@ -122,7 +121,6 @@ class HaoRenderer(util.GPUPass):
         self._boxes: list = []
         self.spec: GridSpec | None = None  # the region's grid (the coarsest cascade)
         self.cascade_specs: tuple[GridSpec, ...] = ()  # finest first
-        self.focus: Focus | None = None
         self.anchor = np.zeros(3)  # world point the GPU passes' positions are relative to
 
     def render(self, objects: list[SceneObject], view_proj: np.ndarray, width: int, height: int,
@@ -156,7 +154,6 @@ class HaoRenderer(util.GPUPass):
 
     def _frame_inputs(self, plan: MethodPlan, objects, view_proj, width, height, settings, region, spheres):
         """(the frame inputs' keys, the Frame): geometry, grid, view and spheres."""
-        voxelized = list(objects)
         geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
         if self._boxes_key != geometry_key:  # object boxes are a pass over every triangle
             self._boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
@@ -171,8 +168,7 @@ class HaoRenderer(util.GPUPass):
         self.anchor = anchor
         self.region = (np.asarray(bounds[0]) - anchor, np.asarray(bounds[1]) - anchor)
         self.spec = grid_for_bounds(*self.region, settings.grid)
-        voxel_boxes = [(k, box) for o, k, box in zip(objects, geometry_key, self._boxes)
-                       if box is not None and o in voxelized]
+        voxel_boxes = [(k, box) for k, box in zip(geometry_key, self._boxes) if box is not None]
 
         def grid_key():
             """Per cascade, the objects reaching into it (read once the cascades are placed):
@@ -194,14 +190,14 @@ class HaoRenderer(util.GPUPass):
                 outside = ~np.all((spheres[0] >= lo) & (spheres[0] <= hi), axis=1)
                 spheres = (spheres[0][outside], spheres[1][outside])
         inputs = {
-            "geometry": (geometry_key, tuple(o.name for o in voxelized), anchor.tobytes()),
+            "geometry": (geometry_key, anchor.tobytes()),
             "region": (self.spec, anchor.tobytes()),
             "grid": grid_key,
             "view": (geometry_key, np.asarray(view_proj, np.float32).tobytes(), width, height),
             "spheres": ((np.asarray(spheres[0], np.float32).tobytes(), np.asarray(spheres[1], np.float32).tobytes())
                         if spheres is not None else None),
         }
-        return inputs, Frame(objects, voxelized, view_proj, width, height, settings, spheres)
+        return inputs, Frame(objects, view_proj, width, height, settings, spheres)
 
     def _sequence(self, plan: MethodPlan, inputs: dict, frame: Frame) -> None:
         """Run the plan's passes whose resource does not hold their key yet. An input may be
@@ -236,15 +232,14 @@ class HaoRenderer(util.GPUPass):
                 return np.zeros((0, 3, 3), np.float32)
             return np.concatenate([(o.positions + (o.offset - anchor)).astype(np.float32) for o in objs])
 
-        objects, voxelized = frame.objects, frame.voxelized
+        objects = frame.objects
         pos = relative(objects)
         nrm = np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32)
         flags = (np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects])
                  if objects else np.zeros(0, np.float32))
-        vpos = relative(voxelized)
-        solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in voxelized]) if voxelized
+        solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in objects]) if objects
                  else np.zeros(0, bool))
-        self.voxels.set_geometry(vpos, dominant_axes(vpos), solid, [len(o.positions) for o in voxelized])
+        self.voxels.set_geometry(pos, dominant_axes(pos), solid, [len(o.positions) for o in objects])
         self.gbuffer.set_geometry(pos, nrm, flags)
         self.back.set_geometry(pos, nrm, flags)
 
@@ -253,12 +248,13 @@ class HaoRenderer(util.GPUPass):
         keeps one grid); returns the placement."""
         settings = frame.settings
         count = settings.cascades if settings.march == "hierarchical" else 1
-        self.focus = self._focus(frame) if count > 1 else None
-        self.cascade_specs = cascade_specs(*self.region, settings.grid, count, self.focus)
+        focus = self._focus(frame) if count > 1 else None
+        self.cascade_specs = cascade_specs(*self.region, settings.grid, count, focus)
         return self.cascade_specs
 
     def _focus(self, frame: Frame) -> Focus | None:
-        """The focus from the G-buffer's depth in the central half of the image."""
+        """The focus from the G-buffer's depth in the central half of the image (a readback,
+        only when the view changed: this pass runs after the G-buffer's)."""
         w, h = frame.width, frame.height
         depth = self.gbuffer.read_depth(w // 4, h // 4, max(w // 2, 1), max(h // 2, 1))
         return focus_from_depth(depth, np.linalg.inv(frame.view_proj), (w, h))

@@ -105,7 +105,6 @@ class VoxelPass(util.GPUPass):
         self.object_boxes: list[tuple[int, int, np.ndarray, np.ndarray]] = []
         self.triangles = 0
         self._plane, self._plane_fb, self._plane_side = None, None, 0
-        self.voxelized_cascades = 0  # cascades (re)voxelized so far
 
     @property
     def spec(self) -> GridSpec | None:
@@ -161,7 +160,6 @@ class VoxelPass(util.GPUPass):
             self._draw_cascade(i, solids and len(specs) == 1)
             self._build_pyramid(i)
         self._contents = contents
-        self.voxelized_cascades += len(redo)
         return len(redo)
 
     def _clear_cascade(self, i: int) -> None:

@@ -154,18 +154,15 @@ def march_reference(occupied: np.ndarray, origin: np.ndarray, voxel: float, poin
     """Accessibility (n,) at (n, 3) points with unit normals against an (nz, ny, nx) bool
     grid, by the GPU's rules (see the module docstring). march: 'fixed' (the paper's
     `steps` samples) or 'hierarchical' (every voxel on the ray, exact DDA: the GPU's budget of
-    `steps` traversal steps is assumed large enough); max_distance <= 0: unlimited (rays run
-    to the grid's exit and every hit occludes fully)."""
+    `steps` traversal steps is assumed large enough; points outside the grid get 1);
+    max_distance <= 0: unlimited (rays run to the grid's exit and every hit occludes fully)."""
+    if march == "hierarchical":  # one grid is one cascade
+        return cascade_march_reference([(occupied, np.asarray(origin), voxel)], points, normals, rays, spread,
+                                       max_distance, falloff)
     points = np.asarray(points, np.float64)
     normals = np.asarray(normals, np.float64)
     jitter = point_jitter(points, voxel)
     dirs = ray_directions(normals, jitter, rays, spread)
-    if march == "hierarchical":
-        t_max = max_distance / voxel if max_distance > 0.0 else np.inf
-        grid_start = (np.repeat(points, rays, axis=0) - np.asarray(origin)) / voxel
-        hit_t = dda_first_hits(occupied, grid_start, dirs.reshape(-1, 3), t_max, np.repeat(normals, rays, axis=0),
-                               SELF_SLAB, MIN_CHORD).reshape(len(points), rays)
-        return 1.0 - occlusion_weight(hit_t * voxel, max_distance, falloff).mean(axis=1)
     offset = SELF_OFFSET * voxel
     start = points + normals * offset
     reach = max_distance if max_distance > 0.0 else fixed_march_reach(occupied.shape, voxel)

@@ -23,29 +23,32 @@ import numpy as np
 from ..kernels import wendland
 
 
-def _pass(values: np.ndarray, positions: np.ndarray, normals: np.ndarray, valid: np.ndarray, axis: int, m: int,
-          max_distance: float) -> np.ndarray:
-    """One full-resolution axis with all four weights (w_h against the pixel's own value)."""
-    h, w = valid.shape
-    radius = m // 2
-    num = np.zeros((h, w))
-    den = np.zeros((h, w))
-    n = valid.shape[axis]
-    for d in range(-radius, radius + 1):
+def _pass(centre: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+          samples: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], axis: int, m: int, max_distance: float,
+          range_weight: bool) -> np.ndarray:
+    """One axis. centre: (values, positions, normals, valid) of the pixels filtered (values:
+    kept where no sample matches); samples: the same of what each pixel offers its
+    neighbours; range_weight: include w_h against the centre's value."""
+    c_values, c_pos, c_nrm, c_valid = centre
+    values, positions, normals, valid = samples
+    num = np.zeros(c_valid.shape)
+    den = np.zeros(c_valid.shape)
+    n = c_valid.shape[axis]
+    for d in range(-(m // 2), m // 2 + 1):
         sl_dst = [slice(None), slice(None)]
         sl_src = [slice(None), slice(None)]
         sl_dst[axis], sl_src[axis] = slice(max(0, -d), n - max(0, d)), slice(max(0, d), n - max(0, -d))
         dst, src = tuple(sl_dst), tuple(sl_src)
         wd = wendland(abs(d), m) if m > 0 else 1.0
-        dot = (normals[dst] * normals[src]).sum(-1)
-        wn = wendland(np.clip(1.0 - dot, 0.0, 2.0), 2.0)
-        wp = wendland(np.linalg.norm(positions[dst] - positions[src], axis=-1), max_distance)
-        wh = wendland(np.abs(values[dst] - values[src]), 1.0)
-        wt = wd * wn * wp * wh * valid[src] * valid[dst]
+        dot = (c_nrm[dst] * normals[src]).sum(-1)
+        wt = wd * wendland(np.clip(1.0 - dot, 0.0, 2.0), 2.0) \
+            * wendland(np.linalg.norm(c_pos[dst] - positions[src], axis=-1), max_distance) * valid[src] * c_valid[dst]
+        if range_weight:
+            wt = wt * wendland(np.abs(c_values[dst] - values[src]), 1.0)
         num[dst] += wt * values[src]
         den[dst] += wt
-    out = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), values)
-    return np.where(valid, out, 1.0)
+    out = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), c_values)
+    return np.where(c_valid, out, 1.0)
 
 
 def joint_bilateral_upsample(low: np.ndarray, low_positions: np.ndarray, low_normals: np.ndarray,
@@ -60,32 +63,14 @@ def joint_bilateral_upsample(low: np.ndarray, low_positions: np.ndarray, low_nor
     window covers by the sample's own position and normal, without the AO range weight: the
     pixel has no AO yet, and its own block's sample can lie on another surface (a floor
     pixel beside a character's silhouette took the character's AO; measured on the walking
-    character over a 40 m floor). Second pass (along y): the first pass's output, with w_h."""
+    character over a 40 m floor); a pixel no sample matches keeps its block's value. Second
+    pass (along y): the first pass's output, with w_h."""
     H, W = valid.shape
     ys, xs = np.arange(H) // scale, np.arange(W) // scale
     up = lambda a: a[ys][:, xs].astype(np.float64)  # noqa: E731 - each pixel's block
-    values, s_pos, s_nrm, s_valid = up(low), up(low_positions), up(low_normals), up(low_valid) > 0.5
-    first = _upsample_pass(values, s_pos, s_nrm, s_valid, up(low), positions, normals, valid, filter_size,
-                           max_distance)
-    return _pass(first, positions, normals, valid, 0, filter_size, max_distance)
-
-
-def _upsample_pass(values, s_pos, s_nrm, s_valid, fallback, positions, normals, valid, m, max_distance):
-    """Along x: num / den of the samples' values weighted by w_d w_n w_p (see above); a pixel
-    no sample matches keeps its block's value."""
-    h, w = valid.shape
-    radius = m // 2
-    num = np.zeros((h, w))
-    den = np.zeros((h, w))
-    for d in range(-radius, radius + 1):
-        dst = (slice(None), slice(max(0, -d), w - max(0, d)))
-        src = (slice(None), slice(max(0, d), w - max(0, -d)))
-        wd = wendland(abs(d), m) if m > 0 else 1.0
-        dot = (normals[dst] * s_nrm[src]).sum(-1)
-        wn = wendland(np.clip(1.0 - dot, 0.0, 2.0), 2.0)
-        wp = wendland(np.linalg.norm(positions[dst] - s_pos[src], axis=-1), max_distance)
-        wt = wd * wn * wp * s_valid[src] * valid[dst]
-        num[dst] += wt * values[src]
-        den[dst] += wt
-    out = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), fallback)
-    return np.where(valid, out, 1.0)
+    blocks = up(low)
+    first = _pass((blocks, positions, normals, valid),
+                  (blocks, up(low_positions), up(low_normals), up(low_valid) > 0.5), 1, filter_size, max_distance,
+                  range_weight=False)
+    full = (first, positions, normals, valid)
+    return _pass(full, full, 0, filter_size, max_distance, range_weight=True)

@@ -27,7 +27,8 @@ class MethodPlan:
     sphere_scope: str = "all"
 
     @property
-    def voxelizes(self) -> bool:
+    def voxels(self) -> bool:
+        """Whether the method voxelizes the scene."""
         return "voxelize" in self.passes
 
 

@@ -21,15 +21,13 @@ class SceneObject:
     world corner normals.
     key: anything hashable that changes whenever the geometry or transform does.
     receiver: 1.0 gets AO; 0.5 has a baked AO map (skipped by HAO, still occludes).
-    solid: also voxelized by parity (closed or nearly closed).
-    proxied: has sphere proxies (left out of the voxels when they stand in for it)."""
+    solid: also voxelized by parity (closed or nearly closed)."""
     name: str
     key: object
     positions: np.ndarray
     normals: np.ndarray
     receiver: float = 1.0
     solid: bool = False
-    proxied: bool = False
     offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def world_positions(self) -> np.ndarray:

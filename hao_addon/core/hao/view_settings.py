@@ -104,11 +104,13 @@ GBUFFER_LAYER_BYTES, FILTER_BYTES, BYTES_PER_AO_PIXEL = 36, 8, 40
 
 
 def render_gpu_bytes(width: int, height: int, settings: ViewAOSettings) -> int:
-    """Estimate of the GPU memory a width x height frame takes (images and voxel grid)."""
+    """Estimate of the GPU memory a width x height frame takes (images and voxel grids: one
+    bit per voxel in each cascade, and its occupancy pyramid, at most 8/7 of that)."""
     low = -(-width // settings.scale) * -(-height // settings.scale)
     layers = 2 if "back_layer" in method_plan(settings.method).passes else 1
     full = width * height * (layers * GBUFFER_LAYER_BYTES + FILTER_BYTES)
-    return full + low * BYTES_PER_AO_PIXEL + settings.grid ** 3 // 8
+    grids = settings.cascades * settings.grid ** 3 // 8 * 8 // 7 if method_plan(settings.method).voxels else 0
+    return full + low * BYTES_PER_AO_PIXEL + grids
 
 
 @dataclass(frozen=True)
