@@ -51,6 +51,7 @@ PAPER_MARCH = dict(march="fixed", steps=8)
 DISTANCE_FACTORS = (0.05, 0.3, 1.0, 3.0, 0.0)  # x the object's height; 0 = unlimited
 CHARACTER_FRAMES = (3, 19, 35)
 CHARACTER_HEIGHT = 1.5  # CesiumMan, scene units
+ALL_PARTS = ("frame", "distances", "character", "sweeps", "triangles")
 
 
 def bunny_soup() -> TriangleSoup:
@@ -94,6 +95,7 @@ def _finish_texture(tex) -> None:
 def timed_frame(renderer, objects, view_proj, settings) -> dict:
     """Run every pass from scratch, each timed to completion (ms)."""
     from hao_addon.gpu.hao_composite import draw_composite
+    from hao_addon.core.hao.view_scene import filled_classes
     from hao_addon.gpu.hao_renderer import filter_range
 
     r = renderer
@@ -102,7 +104,8 @@ def timed_frame(renderer, objects, view_proj, settings) -> dict:
     t = time.perf_counter()
     r.render(objects, view_proj, WIDTH, HEIGHT, settings)  # everything once, uploads included
     out["first_frame_incl_upload"] = 1000 * (time.perf_counter() - t)
-    steps = [("voxelize", lambda: r.voxels.voxelize(r.cascade_specs, settings.march == "fixed"), lambda: r.voxels.grid),
+    fill = filled_classes(settings.march)
+    steps = [("voxelize", lambda: r.voxels.voxelize(r.cascade_specs, fill), lambda: r.voxels.grid),
              ("gbuffer", lambda: r.gbuffer.render(r_view(r, view_proj), WIDTH, HEIGHT), lambda: r.gbuffer.position),
              ("ao", lambda: r.sampling.run(r.gbuffer, r.voxels, settings), lambda: r.sampling.ao_low),
              ("low_gbuffer", lambda: r.low_gbuffer.run(r.gbuffer, settings.scale), lambda: r.low_gbuffer.position),
@@ -355,7 +358,8 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="fewer repeats and points (smoke test)")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
-    ap.add_argument("--parts", default="frame,distances,character,sweeps,triangles")
+    ap.add_argument("--parts", default=",".join(ALL_PARTS),
+                    help="what to run; the other parts stay as the previous hao_bench.json has them")
     ap.add_argument("--plot-only", action="store_true", help="redraw hao_bench.png from hao_bench.json")
     args = ap.parse_args()
     if args.plot_only:
@@ -375,6 +379,10 @@ def main() -> int:
                    settings=dict(width=WIDTH, height=HEIGHT, rays=table1.rays, steps=table1.steps, grid=table1.grid,
                                  scale=table1.scale, filter_size=table1.filter_size, max_distance=0.05,
                                  eevee_samples=EEVEE_SAMPLES, reference_rays=rays, points=count))
+    previous = out / "hao_bench.json"
+    if previous.exists() and set(parts) != set(ALL_PARTS):  # keep the parts not rerun
+        kept = json.loads(previous.read_text())
+        results = {**{k: v for k, v in kept.items() if k not in results}, **results}
     renderer = HaoRenderer()
     vp = view_projection(BENCH_CAMERA)
     if "frame" in parts:

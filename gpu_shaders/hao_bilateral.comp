@@ -23,32 +23,46 @@ void main()
 #endif
   int radius = filter_size / 2;
   ivec2 dir = (AXIS == 0) ? ivec2(1, 0) : ivec2(0, 1);
+  int here = x[AXIS];
+  int first = max(here - radius, 0);
+  int last = min(here + radius, full_size[AXIS] - 1);
   float num = 0.0;
   float den = 0.0;
-  for (int d = -radius; d <= radius; d++) {
-    ivec2 y = x + dir * d;
-    if (any(lessThan(y, ivec2(0))) || any(greaterThanEqual(y, full_size))) {
-      continue;
-    }
 #ifdef UPSAMPLE
-    vec4 py = imageLoad(low_position, y / scale);
-    vec3 ny = imageLoad(low_normal, y / scale).xyz;
-    float hy = imageLoad(ao_src, y / scale).r;
-#else
-    vec4 py = imageLoad(gbuf_position, y);
-    vec3 ny = imageLoad(gbuf_normal, y).xyz;
-    float hy = imageLoad(ao_src, y).r;
-#endif
+  /* The window's pixels of one block share its sample: one look-up per block, weighted by
+   * the distance weights of its pixels summed (the same sum as pixel by pixel). */
+  ivec2 low_x = x / scale;
+  for (int b = first / scale; b <= last / scale; b++) {
+    float wd = 0.0;
+    for (int y = max(b * scale, first); y <= min(b * scale + scale - 1, last); y++) {
+      wd += filter_size > 0 ? wendland(abs(float(y - here)), float(filter_size)) : 1.0;
+    }
+    ivec2 by = (AXIS == 0) ? ivec2(b, low_x.y) : ivec2(low_x.x, b);
+    vec4 py = imageLoad(low_position, by);
     if (py.w < 1.0) {
       continue;
     }
-    float wd = filter_size > 0 ? wendland(abs(float(d)), float(filter_size)) : 1.0;
+    vec3 ny = imageLoad(low_normal, by).xyz;
+    float hy = imageLoad(ao_src, by).r;
     float wt = wd * wendland(clamp(1.0 - dot(nx, ny), 0.0, 2.0), 2.0) * wendland(length(px.xyz - py.xyz), max_distance);
-#ifndef UPSAMPLE
-    wt *= wendland(abs(hx - hy), 1.0);
-#endif
     num += wt * hy;
     den += wt;
   }
+#else
+  for (int k = first; k <= last; k++) {
+    ivec2 y = x + dir * (k - here);
+    vec4 py = imageLoad(gbuf_position, y);
+    if (py.w < 1.0) {
+      continue;
+    }
+    vec3 ny = imageLoad(gbuf_normal, y).xyz;
+    float hy = imageLoad(ao_src, y).r;
+    float wd = filter_size > 0 ? wendland(abs(float(k - here)), float(filter_size)) : 1.0;
+    float wt = wd * wendland(clamp(1.0 - dot(nx, ny), 0.0, 2.0), 2.0) * wendland(length(px.xyz - py.xyz), max_distance)
+        * wendland(abs(hx - hy), 1.0);
+    num += wt * hy;
+    den += wt;
+  }
+#endif
   imageStore(ao_dst, x, vec4(den > 0.0 ? num / den : hx));
 }

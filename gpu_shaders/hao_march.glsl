@@ -55,9 +55,11 @@ float march_hierarchical(vec3 o, vec3 n, vec3 d, float t_begin, float t_limit, i
   float t_end = min(min(min(t_far.x, t_far.y), t_far.z), t_limit);
   t_left = t_end;
   vec3 toward = step(vec3(0.0), dir); /* 1 where the ray runs towards + */
+  ivec3 toward_cell = ivec3(toward);
   int level = 0;
   int offset = 0;
   ivec3 cells = cascade_dims;
+  float side = 1.0;
   float inside = 0.0;   /* length of the current run of occupied voxels on the ray */
   float run_hit = 0.0;  /* the hit distance of the run's first voxel */
   while (budget > 0) {
@@ -65,11 +67,11 @@ float march_hierarchical(vec3 o, vec3 n, vec3 d, float t_begin, float t_limit, i
       return -1.0;
     }
     budget--;
-    float side = float(1 << level);
-    ivec3 c = ivec3(floor((o + d * (t + MARCH_NUDGE)) / side));
+    ivec3 c = ivec3(floor((o + d * (t + MARCH_NUDGE)) * (1.0 / side)));
     if (cell_occupied(offset, cells, c)) {
       if (level > 0) {
         level--;
+        side *= 0.5;
         cells = level_cells(level);
         offset -= cells.x;
         continue;
@@ -92,15 +94,18 @@ float march_hierarchical(vec3 o, vec3 n, vec3 d, float t_begin, float t_limit, i
       inside = 0.0;
     }
     vec3 t_exit = ((vec3(c) + toward) * side - o) * inv;
-    int axis = (t_exit.x <= t_exit.y && t_exit.x <= t_exit.z) ? 0 : ((t_exit.y <= t_exit.z) ? 1 : 2);
-    int here = c[axis];
-    int next = here + (dir[axis] > 0.0 ? 1 : -1);
-    if (inside == 0.0 && level + 1 < cascade_levels && (next >> 1) != (here >> 1)) {
+    float t_next = min(min(t_exit.x, t_exit.y), t_exit.z);
+    /* The ray leaves its parent cell where it leaves through a face on an odd/even side. */
+    bvec3 exits = equal(t_exit, vec3(t_next));
+    bvec3 parent_face = equal(c & 1, toward_cell);
+    bool leaves_parent = (exits.x && parent_face.x) || (exits.y && parent_face.y) || (exits.z && parent_face.z);
+    if (inside == 0.0 && level + 1 < cascade_levels && leaves_parent) {
       offset += cells.x;
       level++;
+      side *= 2.0;
       cells = level_cells(level);
     }
-    t = max(t_exit[axis], t + MARCH_NUDGE);
+    t = max(t_next, t + MARCH_NUDGE);
   }
   t_left = t;
   return -1.0;

@@ -20,9 +20,9 @@ from hao_addon.core.hao.ao_pattern import march_reference
 from hao_addon.core.hao.bilateral import joint_bilateral_upsample
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.reference import reference_accessibility
-from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_scene import CLOSED, NEARLY_CLOSED, OPEN, filled_classes, object_from_soup
 from hao_addon.core.hao.view_settings import ViewAOSettings
-from hao_addon.core.hao.voxel_grid import dominant_axes, grid_for_bounds, solid_reference, voxelize_reference
+from hao_addon.core.hao.voxel_grid import GridSpec, dominant_axes, grid_for_bounds, solid_reference, voxelize_reference
 
 R = 0.5
 
@@ -59,12 +59,12 @@ def test_voxel_grid_matches_cpu_voxelization(renderer):
                           torus.uvs)
     plane = scenes.grid_plane(2.0, 8)
     objs = [object_from_soup(tilted, "t"), object_from_soup(plane, "p")]
-    assert objs[0].solid and not objs[1].solid
+    assert objs[0].fill == CLOSED and objs[1].fill == OPEN
     pos = np.concatenate([o.world_positions() for o in objs])
     for resolution in (64, 128):
         spec = grid_for_bounds(pos.reshape(-1, 3).min(0), pos.reshape(-1, 3).max(0), resolution)
         renderer.voxels.set_geometry(pos.astype(np.float32), dominant_axes(pos),
-                                     np.repeat([True, False], [len(objs[0].positions), len(objs[1].positions)]))
+                                     np.repeat([CLOSED, OPEN], [len(objs[0].positions), len(objs[1].positions)]))
         renderer.voxels.voxelize(spec)
         gpu_grid = renderer.voxels.read_grid()
         surface, amb_s = voxelize_reference(pos, spec)
@@ -75,6 +75,31 @@ def test_voxel_grid_matches_cpu_voxelization(renderer):
         assert not (differ & ~ambiguous).any(), f"{(differ & ~ambiguous).sum()} unambiguous voxels differ"
         assert differ.sum() <= 0.05 * expected.sum()
         assert solid.sum() > surface.sum()  # the torus is filled, not a shell
+    # Cascades that cut the torus (its upper half above a finer one): each fills like its own
+    # grid, since a column's parity counts every crossing, those outside its box included.
+    outer = grid_for_bounds(pos.reshape(-1, 3).min(0), pos.reshape(-1, 3).max(0), 64)
+    inner = GridSpec((-0.5, -0.5, 0.0), outer.voxel / 2.0, (64, 64, 32))
+    renderer.voxels.voxelize((inner, outer))
+    for k, spec in enumerate((inner, outer)):
+        gpu_grid = renderer.voxels.read_grid(cascade=k)
+        surface, amb_s = voxelize_reference(pos, spec)
+        solid, amb_v = solid_reference(objs[0].world_positions(), spec)
+        differ = gpu_grid != (surface | solid)
+        assert not (differ & ~(amb_s | amb_v)).any(), (k, (differ & ~(amb_s | amb_v)).sum())
+        assert solid.sum() > surface.sum()
+    renderer.voxels.voxelize((inner, outer), fill=CLOSED + 1)  # nothing is filled
+    assert renderer.voxels.read_grid(cascade=0).sum() < solid_reference(objs[0].world_positions(), inner)[0].sum()
+
+
+def test_fill_classes():
+    """Closed meshes are filled for both marches, a scan with a few holes only for the
+    paper's fixed steps (the hierarchical march would leak the fill through its holes),
+    sheets never."""
+    torus = scenes.torus(0.6, 0.2, (0.0, 0.0, 0.2), 40, 20)
+    holed = TriangleSoup(torus.positions[1:], None)  # one missing triangle: 3 border edges of 1200
+    classes = [object_from_soup(s).fill for s in (torus, holed, scenes.grid_plane(2.0, 8))]
+    assert classes == [CLOSED, NEARLY_CLOSED, OPEN]
+    assert filled_classes("fixed") == NEARLY_CLOSED and filled_classes("hierarchical") == CLOSED
 
 
 @pytest.mark.parametrize("march, steps, falloff, max_distance", [

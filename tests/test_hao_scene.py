@@ -13,7 +13,7 @@ import numpy as np
 from conftest import ROOT
 from hao_addon.core.hao import camera_math as cm
 from hao_addon.core import scenes
-from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_scene import CLOSED, OPEN, object_from_soup
 from hao_addon.core.hao.view_settings import ViewAOSettings
 
 
@@ -140,7 +140,7 @@ def test_scene_objects_are_evaluated_and_cached(addon, gpu_context):
     # Subdivision applied: 4x the base mesh's triangles; the closed sphere is a solid.
     sphere.data.calc_loop_triangles()
     assert len(objs[sphere.name].positions) > 3 * len(sphere.data.loop_triangles)
-    assert objs[sphere.name].solid and not objs["Plane"].solid
+    assert objs[sphere.name].fill == CLOSED and objs["Plane"].fill == OPEN
     again = {o.name: o for o in visible_scene_objects(dg, bpy.context.view_layer)}
     assert again[sphere.name] is objs[sphere.name]  # unchanged: the cached arrays are reused
     sphere.location.z += 0.25

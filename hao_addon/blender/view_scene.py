@@ -16,8 +16,7 @@ import bpy
 import mathutils
 import numpy as np
 
-from ..core.geometry import boundary_edge_fraction
-from ..core.hao.view_scene import SOLID_BORDER_FRACTION, SceneObject
+from ..core.hao.view_scene import OPEN, SceneObject, fill_class
 from .mesh_data import read_positions
 
 BAKED_AO_PROPERTY = "hao_ao_image"  # set on objects by the Bake AO operator
@@ -50,10 +49,10 @@ def _build(obj_eval, mesh, key: str) -> SceneObject:
     normals = corner.reshape(-1, 3)[tri_loops] @ normal_matrix.T
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     positions = world[tri_verts].reshape(-1, 3, 3)
-    solid = boundary_edge_fraction(positions) <= SOLID_BORDER_FRACTION if n_tri else False
+    fill = fill_class(positions) if n_tri else OPEN
     offset = 0.5 * (world.min(0) + world.max(0)) if len(world) else np.zeros(3)
     return SceneObject(obj_eval.name, key, (positions - offset).astype(np.float32),
-                       normals.reshape(-1, 3, 3).astype(np.float32), 1.0, bool(solid), offset=offset)
+                       normals.reshape(-1, 3, 3).astype(np.float32), 1.0, fill, offset=offset)
 
 
 def visible_scene_objects(depsgraph: bpy.types.Depsgraph, view_layer: bpy.types.ViewLayer,

@@ -29,7 +29,7 @@ import numpy as np
 from ..core.errors import BakeInputError
 from ..core.hao.cascades import Focus, cascade_specs, focus_from_depth
 from ..core.hao.methods import MethodPlan, method_plan
-from ..core.hao.view_scene import SceneObject, render_anchor, scene_bounds
+from ..core.hao.view_scene import SceneObject, filled_classes, render_anchor, scene_bounds
 from ..core.hao.view_settings import ViewAOSettings
 from ..core.hao.voxel_grid import GridSpec, dominant_axes, grid_for_bounds
 from . import util
@@ -154,7 +154,7 @@ class HaoRenderer(util.GPUPass):
 
     def _frame_inputs(self, plan: MethodPlan, objects, view_proj, width, height, settings, region, spheres):
         """(the frame inputs' keys, the Frame): geometry, grid, view and spheres."""
-        geometry_key = tuple((o.name, o.key, o.receiver, o.solid, len(o.positions)) for o in objects)
+        geometry_key = tuple((o.name, o.key, o.receiver, o.fill, len(o.positions)) for o in objects)
         if self._boxes_key != geometry_key:  # object boxes are a pass over every triangle
             self._boxes = [o.world_bounds() if len(o.positions) else None for o in objects]
             self._boxes_key = geometry_key
@@ -237,9 +237,9 @@ class HaoRenderer(util.GPUPass):
         nrm = np.concatenate([o.normals for o in objects]) if objects else np.zeros((0, 3, 3), np.float32)
         flags = (np.concatenate([np.full(len(o.positions), o.receiver, np.float32) for o in objects])
                  if objects else np.zeros(0, np.float32))
-        solid = (np.concatenate([np.full(len(o.positions), o.solid) for o in objects]) if objects
-                 else np.zeros(0, bool))
-        self.voxels.set_geometry(pos, dominant_axes(pos), solid, [len(o.positions) for o in objects])
+        fill = (np.concatenate([np.full(len(o.positions), o.fill, np.int8) for o in objects]) if objects
+                else np.zeros(0, np.int8))
+        self.voxels.set_geometry(pos, dominant_axes(pos), fill, [len(o.positions) for o in objects])
         self.gbuffer.set_geometry(pos, nrm, flags)
         self.back.set_geometry(pos, nrm, flags)
 
@@ -260,11 +260,8 @@ class HaoRenderer(util.GPUPass):
         return focus_from_depth(depth, np.linalg.inv(frame.view_proj), (w, h))
 
     def _run_voxelize(self, frame: Frame) -> None:
-        # Closed objects are filled only for the paper's march, which steps over shells; the
-        # hierarchical march visits every voxel, and a fill would darken what a scan's holes
-        # leak it into (the floor under the Stanford bunny's open base).
         per_cascade, march = frame.inputs["grid"]
-        self.stats["cascades_voxelized"] += self.voxels.voxelize(self.cascade_specs, solids=march == "fixed",
+        self.stats["cascades_voxelized"] += self.voxels.voxelize(self.cascade_specs, fill=filled_classes(march),
                                                                  keys=per_cascade)
 
     def _run_gbuffer(self, frame: Frame) -> None:

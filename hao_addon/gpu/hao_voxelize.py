@@ -9,6 +9,7 @@ import gpu
 import numpy as np
 
 from ..core.hao.cascades import atlas_layout
+from ..core.hao.view_scene import NEARLY_CLOSED
 from ..core.hao.voxel_grid import GridSpec, atlas_words, level_count, level_dims, level_offsets
 from . import util
 from .shaders import cached_shader, glsl_source
@@ -97,7 +98,10 @@ class VoxelPass(util.GPUPass):
 
     def __init__(self) -> None:
         super().__init__()
-        self.surface_batch = self.solid_batch = None
+        self.surface_batch = None
+        self._fill_positions = np.zeros((0, 3, 3), np.float32)
+        self._fill = np.zeros(0, np.int8)
+        self._fill_batches: dict[int, object] = {}  # least fill class -> batch of those triangles
         self.grid = None
         self.specs: tuple[GridSpec, ...] = ()
         self.y_offsets: list[int] = []
@@ -115,18 +119,18 @@ class VoxelPass(util.GPUPass):
     def levels(self) -> int:
         return level_count(self.spec.dims) if self.spec else 1
 
-    def set_geometry(self, positions: np.ndarray, axes: np.ndarray, solid: np.ndarray,
+    def set_geometry(self, positions: np.ndarray, axes: np.ndarray, fill: np.ndarray,
                      object_faces: list[int] | None = None) -> None:
-        """positions: (F, 3, 3) world; axes: (F,) dominant axis; solid: (F,) bool, triangles
-        of closed objects that also go into the solid (parity) pass; object_faces: the face
-        count of each object, in order (cascades draw only the objects reaching into them)."""
+        """positions: (F, 3, 3) world; axes: (F,) dominant axis; fill: (F,) the fill class of
+        each triangle's object (core/hao/view_scene.py: those a voxelization fills also go
+        into the parity pass); object_faces: the face count of each object, in order
+        (cascades draw only the objects reaching into them)."""
         pos = positions.reshape(-1, 3)
         axis = np.repeat(np.asarray(axes, np.float32), 3)
         self.triangles = len(positions)
         self.surface_batch = util.make_batch('TRIS', {"pos": ('F32', pos), "axis": ('F32', axis)}) if len(pos) else None
-        sp = positions[np.asarray(solid, bool)].reshape(-1, 3)
-        self.solid_batch = (util.make_batch('TRIS', {"pos": ('F32', sp), "axis": ('F32', np.zeros(len(sp)))})
-                            if len(sp) else None)
+        self._fill_positions, self._fill = positions, np.asarray(fill, np.int8)
+        self._fill_batches = {}
         counts = [len(positions)] if object_faces is None else list(object_faces)
         ends = np.cumsum(counts).astype(int)
         self.object_boxes = []
@@ -136,11 +140,20 @@ class VoxelPass(util.GPUPass):
                 self.object_boxes.append((int(first), int(end), flat.min(0), flat.max(0)))
         # The cascades keep their voxels: each one's key names the objects in it.
 
-    def voxelize(self, spec: "GridSpec | tuple[GridSpec, ...]", solids: bool = True,
+    def fill_batch(self, least: int):
+        """The batch of the triangles whose fill class is at least `least` (None: none)."""
+        if least not in self._fill_batches:
+            sp = self._fill_positions[self._fill >= least].reshape(-1, 3)
+            self._fill_batches[least] = (util.make_batch('TRIS', {"pos": ('F32', sp), "axis": ('F32', np.zeros(len(sp)))})
+                                         if len(sp) else None)
+        return self._fill_batches[least]
+
+    def voxelize(self, spec: "GridSpec | tuple[GridSpec, ...]", fill: int = NEARLY_CLOSED,
                  keys: tuple | None = None) -> int:
         """Voxelize the geometry into the cascades' grids (finest first; one GridSpec: one
-        grid) and build their pyramids. solids: closed objects filled (core/hao/voxel_grid.py,
-        one grid only). keys: per cascade, what reaches into it (None: redo every cascade);
+        grid) and build their pyramids. fill: objects of at least this fill class are filled
+        (core/hao/voxel_grid.py; a column's parity counts every crossing, also those outside a
+        cascade's box, so each cascade fills alike). keys: per cascade, what reaches into it (None: redo every cascade);
         a cascade whose grid and key are unchanged keeps its voxels. Returns how many
         cascades were voxelized."""
         specs = (spec,) if isinstance(spec, GridSpec) else tuple(spec)
@@ -157,7 +170,7 @@ class VoxelPass(util.GPUPass):
         self.specs, self.y_offsets = specs, offsets
         for i in redo:
             self._clear_cascade(i)
-            self._draw_cascade(i, solids and len(specs) == 1)
+            self._draw_cascade(i, self.fill_batch(fill))
             self._build_pyramid(i)
         self._contents = contents
         return len(redo)
@@ -171,7 +184,7 @@ class VoxelPass(util.GPUPass):
         gpu.compute.dispatch(shader, -(-words[0] // 8), -(-words[1] // 8), words[2])
         gpu.shader.unbind()
 
-    def _draw_cascade(self, i: int, solids: bool) -> None:
+    def _draw_cascade(self, i: int, fill_batch) -> None:
         spec = self.specs[i]
         side = max(spec.dims)
         if self._plane_side < side:  # the colour target only sizes the raster plane
@@ -185,8 +198,8 @@ class VoxelPass(util.GPUPass):
         with util.scoped_state(), self._plane_fb.bind():
             util.set_overlay_pass_state(side, side)
             # Parity first, then the surface ORed over it: XOR and OR do not commute.
-            for solid, batch in ((True, self.solid_batch), (False, self.surface_batch)):
-                if batch is None or (solid and not solids):
+            for solid, batch in ((True, fill_batch), (False, self.surface_batch)):
+                if batch is None:
                     continue
                 size = (spec.dims[0], spec.dims[1]) if solid else (side, side)  # solid: columns along z
                 gpu.state.viewport_set(0, 0, *size)
@@ -236,6 +249,7 @@ class VoxelPass(util.GPUPass):
         return unpack_bits(words)[:level_dims(dims, level)[2]]
 
     def _release(self) -> None:
-        self.surface_batch = self.solid_batch = self.grid = None
+        self.surface_batch = self.grid = None
+        self._fill_batches = {}
         self._contents = []
         self._plane, self._plane_fb, self._plane_side = None, None, 0

@@ -9,9 +9,28 @@ import numpy as np
 
 from ..geometry import TriangleSoup, boundary_edge_fraction, face_normals_areas
 
-# Objects with at most this fraction of border edges are voxelized as solids (a scan with a
-# few holes, like the Stanford bunny's open base, at 0.2 %); sheets and planes stay surfaces.
+# How the voxelization fills an object's inside (parity along z, core/hao/voxel_grid.py):
+# OPEN objects (sheets, planes) stay surfaces; NEARLY_CLOSED ones have at most
+# SOLID_BORDER_FRACTION border edges (a scan with a few holes, like the Stanford bunny's open
+# base, at 0.2 %); CLOSED ones have none.
+OPEN, NEARLY_CLOSED, CLOSED = 0, 1, 2
 SOLID_BORDER_FRACTION = 0.01
+
+
+def fill_class(positions: np.ndarray) -> int:
+    """OPEN, NEARLY_CLOSED or CLOSED for (F, 3, 3) triangles."""
+    border = boundary_edge_fraction(positions)
+    return CLOSED if border == 0.0 else (NEARLY_CLOSED if border <= SOLID_BORDER_FRACTION else OPEN)
+
+
+def filled_classes(march: str) -> int:
+    """The least fill class a march fills. The paper's fixed steps step over shells, so every
+    (nearly) closed object is filled; the hierarchical march visits every voxel and needs a
+    fill only where a surface lies inside its slab (an occluder resting on the receiver:
+    under a ball on a floor the ray passes the ball's lower shell there and would next meet
+    its far side), and only closed objects are filled, since a scan's holes would leak the
+    fill (below the bunny's open base: its whole column)."""
+    return NEARLY_CLOSED if march == "fixed" else CLOSED
 
 
 @dataclass
@@ -21,13 +40,13 @@ class SceneObject:
     world corner normals.
     key: anything hashable that changes whenever the geometry or transform does.
     receiver: 1.0 gets AO; 0.5 has a baked AO map (skipped by HAO, still occludes).
-    solid: also voxelized by parity (closed or nearly closed)."""
+    fill: OPEN, NEARLY_CLOSED or CLOSED (fill_class): which marches fill its inside."""
     name: str
     key: object
     positions: np.ndarray
     normals: np.ndarray
     receiver: float = 1.0
-    solid: bool = False
+    fill: int = OPEN
     offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def world_positions(self) -> np.ndarray:
@@ -46,7 +65,7 @@ def object_from_soup(soup: TriangleSoup, key: object = 0, receiver: float = 1.0)
     offset = 0.5 * (flat.min(0) + flat.max(0))
     return SceneObject(soup.name, key, (soup.positions - offset).astype(np.float32),
                        np.repeat(normals[:, None], 3, axis=1).astype(np.float32), receiver,
-                       boundary_edge_fraction(soup.positions) <= SOLID_BORDER_FRACTION, offset=offset)
+                       fill_class(soup.positions), offset=offset)
 
 
 def scene_bounds(objects: list[SceneObject], boxes: list | None = None) -> tuple[np.ndarray, np.ndarray] | None:
