@@ -549,10 +549,11 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     stems = [Path(path).stem for path in args.input]
     if INPUT_TOKEN not in template and len(set(stems)) > 1:
         raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
+    from .gpu.shaders import cached_shader_count
     lines = []
     for path, stem in zip(args.input, stems):
         one = Report(command="bake", input=str(path), hao=report.hao, blender=report.blender)
-        started = time.perf_counter()
+        started, shaders = time.perf_counter(), cached_shader_count()
         sub = argparse.Namespace(**vars(args))
         sub.input, sub.out = path, str(folder / template.replace(INPUT_TOKEN, stem))
         try:
@@ -564,6 +565,7 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
             one.status, one.exit_code, one.error = "error", code, message
             report.input_errors.append(f"{path}: {message}")
         one.timings["total"] = round(time.perf_counter() - started, 4)
+        one.shaders_compiled = cached_shader_count() - shaders
         report.inputs.append(one.as_dict())
         report.outputs.extend(one.outputs)
         report.warnings.extend(f"{path}: {w}" for w in one.warnings)

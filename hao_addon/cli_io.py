@@ -200,6 +200,8 @@ class Report:
     input_errors: list = field(default_factory=list)
     # A frame sequence: per frame {frame, seconds, reused, outputs}.
     frames: list = field(default_factory=list)
+    # A batch's input: the GPU shader variants it compiled (the first compiles, the rest reuse).
+    shaders_compiled: int | None = None
 
     @contextlib.contextmanager
     def phase(self, name: str) -> Iterator[None]:
@@ -215,6 +217,8 @@ class Report:
             del out["inputs"], out["input_errors"]
         if not self.frames:
             del out["frames"]
+        if self.shaders_compiled is None:
+            del out["shaders_compiled"]
         return out
 
     def to_json(self) -> str:
