@@ -450,6 +450,16 @@ def main() -> int:
     return 0
 
 
+def _rmse_axes(ax, xlabel: str, ylabel: str, title: str, legend_size: int) -> None:
+    """Log RMSE axes with the 0.03 target line."""
+    ax.axhline(0.03, color="gray", ls="--", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=legend_size)
+
+
 def plot(results, path) -> None:
     import matplotlib
     matplotlib.use("Agg")
@@ -476,24 +486,16 @@ def plot(results, path) -> None:
                 for key, style in (("hao", "o-"), ("paper", "s:"), ("eevee", "^--")):
                     ax.plot(labels, [r[key]["rmse"] for r in m["rows"]], style, color=f"C{i}",
                             label=f"{name} {key}" if key == "hao" or i == 0 else None, alpha=1.0 if key == "hao" else 0.5)
-            ax.axhline(0.03, color="gray", ls="--", lw=0.8)
-            ax.set_yscale("log")
-            ax.set_xlabel("d_max / object height")
-            ax.set_ylabel("RMSE vs ray-traced truth")
-            ax.set_title("Accuracy at every distance (solid HAO, dotted paper march, dashed EEVEE)")
-            ax.legend(fontsize=6)
+            _rmse_axes(ax, "d_max / object height", "RMSE vs ray-traced truth",
+                       "Accuracy at every distance (solid HAO, dotted paper march, dashed EEVEE)", 6)
         elif panel == "character_methods":
             for d, marker in (("0.5", "o"), ("0", "s")):
                 for i, m in enumerate(CHARACTER_METHODS):
                     rows = [r[d]["visible"][m] for r in results["character_methods"].values()]
                     ax.scatter([r["frame_ms"] for r in rows], [r["rmse"] for r in rows], marker=marker, color=f"C{i}",
                                label=m if d == "0.5" else None, alpha=0.8)
-            ax.axhline(0.03, color="gray", ls="--", lw=0.8)
-            ax.set_yscale("log")
-            ax.set_xlabel("frame ms")
-            ax.set_ylabel("RMSE (visible pixels)")
-            ax.set_title("Character methods: d_max 0.5 (circles), unlimited (squares)")
-            ax.legend(fontsize=7)
+            _rmse_axes(ax, "frame ms", "RMSE (visible pixels)",
+                       "Character methods: d_max 0.5 (circles), unlimited (squares)", 7)
         else:
             tr = results["triangles"]
             for p in PASSES:

@@ -6,19 +6,6 @@
  * background and skipped pixels. Counters: [0] sampled pixels, [1] rays that spent their
  * step budget. */
 
-/* Occlusion of a hit at distance t (world units, the start offset included). */
-float hit_weight(float t)
-{
-  if (max_distance <= 0.0) {
-    return 1.0; /* unlimited: every hit occludes fully */
-  }
-#ifdef WENDLAND_FALLOFF
-  return wendland(t, max_distance);
-#else
-  return (t < max_distance) ? 1.0 : 0.0;
-#endif
-}
-
 /* The finest cascade holding point q, or -1 (outside the region). */
 int cascade_of(vec3 q)
 {
@@ -91,7 +78,7 @@ void main()
     hit = (hit >= 0.0) ? hit * voxel + offset : -1.0;
 #endif
     if (hit >= 0.0) {
-      occlusion += hit_weight(hit);
+      occlusion += occlusion_weight(hit, max_distance); /* hit: world units, start offset included */
     }
   }
 #ifdef MARCH_HIERARCHICAL

@@ -10,6 +10,21 @@ float wendland(float t, float h)
   return y * y * y * y * (4.0 * x + 1.0);
 }
 
+/* The AO's distance falloff at distance t (numpy twin: core/kernels.occlusion_weight):
+ * Wendland with WENDLAND_FALLOFF defined, else a step at d_max; d_max <= 0 is unlimited
+ * distance, where every hit occludes fully. */
+float occlusion_weight(float t, float d_max)
+{
+  if (d_max <= 0.0) {
+    return 1.0;
+  }
+#ifdef WENDLAND_FALLOFF
+  return wendland(t, d_max);
+#else
+  return (t < d_max) ? 1.0 : 0.0;
+#endif
+}
+
 /* PCG3D hash (Jarzynski & Olano 2020). */
 uvec3 pcg3d(uvec3 v)
 {

@@ -9,18 +9,6 @@
  * facing patch, so the two layers do not count it twice), and its sphere's cross-section
  * equals the patch's area seen from the receiver; M random samples of the disk stand for all
  * its pixels, each sample's occlusion weighted by (disk pixels) / M. */
-/* The AO's distance falloff (core/kernels.occlusion_weight) at a sample's distance. */
-float distance_weight(float t)
-{
-  if (max_distance <= 0.0) {
-    return 1.0;
-  }
-#ifdef WENDLAND_FALLOFF
-  return wendland(t, max_distance);
-#else
-  return (t < max_distance) ? 1.0 : 0.0;
-#endif
-}
 
 vec3 layer_normal_at(int layer, ivec2 q)
 {
@@ -84,7 +72,7 @@ void main()
       float dist = length(pc);
       float sin_t = min(r / max(dist, r), 1.0);
       float solid_angle = 6.283185307179586 * (1.0 - sqrt(max(1.0 - sin_t * sin_t, 0.0)));
-      occlusion += weight * distance_weight(d) * (dist > 0.0 ?
+      occlusion += weight * occlusion_weight(d, max_distance) * (dist > 0.0 ?
                                  min(solid_angle * max(dot(n, pc) / max(dist, 1e-12), 0.0) / 3.141592653589793, 1.0) :
                                  1.0);
     }

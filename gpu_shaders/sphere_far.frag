@@ -3,17 +3,6 @@
  * weighted as core/proxies/sphere_ao.sphere_weight: the AO's distance falloff halfway into
  * the sphere, and with a near field (near_radius > 0) the sphere's share beyond its radius.
  * Multiplicative blending into the AO map: A *= 1 - occlusion. */
-float distance_weight(float t)
-{
-  if (max_distance <= 0.0) {
-    return 1.0;
-  }
-#ifdef WENDLAND_FALLOFF
-  return wendland(t, max_distance);
-#else
-  return (t < max_distance) ? 1.0 : 0.0;
-#endif
-}
 
 void main()
 {
@@ -36,7 +25,7 @@ void main()
     float solid_angle = 6.283185307179586 * (1.0 - sqrt(max(1.0 - sin_t * sin_t, 0.0)));
     occlusion = min(solid_angle * max(dot(n, pc) / dist, 0.0) / 3.141592653589793, 1.0);
   }
-  occlusion *= distance_weight(max(dist - 0.5 * r, 0.0));
+  occlusion *= occlusion_weight(max(dist - 0.5 * r, 0.0), max_distance);
   if (near_radius > 0.0) {
     occlusion *= clamp((dist + r - near_radius) / (2.0 * max(r, 1e-30)), 0.0, 1.0);
   }

@@ -277,3 +277,18 @@ def test_far_from_the_origin_and_at_any_scale(renderer):
         # power of ten is not): same noise or a re-drawn one; filtered, within 0.03 RMSE.
         assert np.sqrt((diff * diff).mean()) < 0.03, (shift, scale)
         assert abs(diff.mean()) < 0.01, (shift, scale)
+
+
+def test_switching_march_refills_the_grid(renderer):
+    """The fixed march fills a nearly closed mesh, the hierarchical one does not: switching
+    between them on the same grid voxelizes it again with the other fill."""
+    torus = scenes.torus(0.6, 0.2, (0.0, 0.0, 0.2), 40, 20)
+    holed = object_from_soup(TriangleSoup(torus.positions[1:], None), "holed")
+    objs = [holed, object_from_soup(scenes.grid_plane(2.0, 8), "plane")]
+    vp, w, h = view((2.0, -2.5, 2.0))
+    settings = ViewAOSettings(rays=8, grid=64, cascades=1)
+    occupied = {}
+    for march in ("fixed", "hierarchical", "fixed"):
+        renderer.render(objs, vp, w, h, settings.with_(march=march, steps=8 if march == "fixed" else 128))
+        occupied.setdefault(march, []).append(int(renderer.voxels.read_grid().sum()))
+    assert occupied["fixed"][0] == occupied["fixed"][1] > 2 * occupied["hierarchical"][0]

@@ -10,9 +10,10 @@ import pytest
 from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.hao.ao_pattern import march_reference
-from hao_addon.core.hao.view_scene import object_from_soup
+from hao_addon.core.hao.view_scene import OPEN, object_from_soup
 from hao_addon.core.hao.view_settings import ViewAOSettings
 from hao_addon.core.hao.voxel_grid import occupancy_pyramid
+from hao_addon.core.reference import reference_accessibility
 from test_hao import low_res_samples, sphere_plane_scene, view, R
 
 
@@ -135,8 +136,6 @@ def test_occluder_resting_on_the_receiver_is_filled(renderer, max_distance):
     the slab. Against ray-traced truth: RMSE 0.072 / 0.056 filled (what is left is the gap
     thinner than a voxel, closed by the voxels: bias -0.03 / -0.05; more rays do not change
     it) against 0.27 / 0.26 as a shell."""
-    from hao_addon.core.hao.view_scene import OPEN
-    from hao_addon.core.reference import reference_accessibility
     settings = ViewAOSettings(rays=128, max_distance=max_distance, grid=96, filter_size=0)
     vp, w, h = view((1.6, -0.3, 0.3), target=(0.0, 0.0, 0.0), width=256, height=192, fov=0.9)
     errors = {}

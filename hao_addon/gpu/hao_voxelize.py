@@ -9,7 +9,7 @@ import gpu
 import numpy as np
 
 from ..core.hao.cascades import atlas_layout
-from ..core.hao.view_scene import NEARLY_CLOSED
+from ..core.hao.view_scene import NEARLY_CLOSED, OPEN
 from ..core.hao.voxel_grid import GridSpec, atlas_words, level_count, level_dims, level_offsets
 from . import util
 from .shaders import cached_shader, glsl_source
@@ -129,7 +129,9 @@ class VoxelPass(util.GPUPass):
         axis = np.repeat(np.asarray(axes, np.float32), 3)
         self.triangles = len(positions)
         self.surface_batch = util.make_batch('TRIS', {"pos": ('F32', pos), "axis": ('F32', axis)}) if len(pos) else None
-        self._fill_positions, self._fill = positions, np.asarray(fill, np.int8)
+        fill = np.asarray(fill, np.int8)
+        fillable = fill > OPEN
+        self._fill_positions, self._fill = positions[fillable], fill[fillable]
         self._fill_batches = {}
         counts = [len(positions)] if object_faces is None else list(object_faces)
         ends = np.cumsum(counts).astype(int)
@@ -145,7 +147,7 @@ class VoxelPass(util.GPUPass):
         if least not in self._fill_batches:
             sp = self._fill_positions[self._fill >= least].reshape(-1, 3)
             self._fill_batches[least] = (util.make_batch('TRIS', {"pos": ('F32', sp), "axis": ('F32', np.zeros(len(sp)))})
-                                         if len(sp) else None)
+                                         if len(sp) else None)  # axis unused: the parity pass projects along z
         return self._fill_batches[least]
 
     def voxelize(self, spec: "GridSpec | tuple[GridSpec, ...]", fill: int = NEARLY_CLOSED,
@@ -153,9 +155,9 @@ class VoxelPass(util.GPUPass):
         """Voxelize the geometry into the cascades' grids (finest first; one GridSpec: one
         grid) and build their pyramids. fill: objects of at least this fill class are filled
         (core/hao/voxel_grid.py; a column's parity counts every crossing, also those outside a
-        cascade's box, so each cascade fills alike). keys: per cascade, what reaches into it (None: redo every cascade);
-        a cascade whose grid and key are unchanged keeps its voxels. Returns how many
-        cascades were voxelized."""
+        cascade's box, so each cascade fills alike). keys: per cascade, what reaches into it
+        (None: redo every cascade); a cascade whose grid, key and fill are unchanged keeps its
+        voxels. Returns how many cascades were voxelized."""
         specs = (spec,) if isinstance(spec, GridSpec) else tuple(spec)
         keys = tuple(keys) if keys is not None else (None,) * len(specs)
         size, offsets = atlas_layout(specs)
@@ -164,7 +166,7 @@ class VoxelPass(util.GPUPass):
             self.grid.clear(format='UINT', value=(0,))
             self._contents = []
         self.grid_size = size
-        contents = [(s, y, k) for s, y, k in zip(specs, offsets, keys)]
+        contents = [(s, y, k, fill) for s, y, k in zip(specs, offsets, keys)]  # the fill too: a march switch
         redo = [i for i, c in enumerate(contents)
                 if c[2] is None or i >= len(self._contents) or self._contents[i] != c]
         self.specs, self.y_offsets = specs, offsets
