@@ -44,10 +44,12 @@ from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa:
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
 from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.bake_gather import VIEWS_PER_DISPATCH  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tools"))
 from cycles_bake import cycles_ao_bake  # noqa: E402
 
+WARM_UP_DIRECTIONS = VIEWS_PER_DISPATCH
 MESHES = {"rocker-arm": ROOT / "tests" / "data" / "rocker-arm.obj",
           "bunny": ROOT / "bench" / "data" / "stanford-bunny.obj"}
 
@@ -98,9 +100,10 @@ def cycles_bake(soup, size, samples_list):
 def hao_runs(soup, size, method, directions_list, view_samples=2.0, high_to_low=None, **settings):
     out = []
     # Warm-up (not timed): shader compilation (LLVM JIT, ~0.1 s per variant) happens once per
-    # session, and Cycles gets the same courtesy in cycles_bake.
-    bake(soup, [], BakeSettings(size=size, directions=8, method=method, view_samples=view_samples, margin=0,
-                                **settings), use_cache=False, high_to_low=high_to_low)
+    # session, and Cycles gets the same courtesy in cycles_bake. WARM_UP_DIRECTIONS fill the
+    # gather's largest batch, so the timed bakes use the variant compiled here.
+    bake(soup, [], BakeSettings(size=size, directions=WARM_UP_DIRECTIONS, method=method, view_samples=view_samples,
+                                margin=0, **settings), use_cache=False, high_to_low=high_to_low)
     for d in directions_list:
         t = time.perf_counter()
         # margin=0 as in cycles_bake: neither grows islands (error is measured inside them).
@@ -206,7 +209,7 @@ def triangle_sweep(quick):
     for seg, rings in tess:
         sphere = scenes.uv_sphere(1.0, (0, 0, 1.0), seg, rings)
         target = sphere  # the sphere itself is baked: its triangle count drives the cost
-        bake(target, [plane], BakeSettings(size=1024, directions=8), use_cache=False)  # warm
+        bake(target, [plane], BakeSettings(size=1024, directions=WARM_UP_DIRECTIONS), use_cache=False)  # warm
         t = time.perf_counter()
         res = bake(target, [plane], BakeSettings(size=1024, directions=64), use_cache=False)
         dt = time.perf_counter() - t

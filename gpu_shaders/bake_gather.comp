@@ -1,5 +1,6 @@
 /* Shadow-map gather (the comparison of McGraw & Sowers' Table 1): every texel-list entry is
- * tested against the depth maps of VIEWS directions (1 to 4, one dispatch) and adds the
+ * tested against the depth maps of the directions of one dispatch (GATHER_ALL_VIEWS: up to
+ * GATHER_MAX_VIEWS, bake_gather.py; a slot with omega = 0 is padding and adds nothing) and adds the
  * estimator's term of (w, V, omega) for each (bake_estimator.glsl; for AO (V w, w)),
  * w = weight(omega . n) times the entry's scale (1 / S where the plan knows it; each entry's
  * sums are divided by its own weight sum on read-back, estimators.texel_sums). Loading an entry and its running sums once for
@@ -162,16 +163,7 @@ void main()
 #endif
   EstimatorSums sum = ESTIMATOR_LOAD(accum, slot);
   EstimatorSums before = sum;
-  GATHER_VIEW(depth_tex0, 0)
-#if VIEWS > 1
-  GATHER_VIEW(depth_tex1, 1)
-#endif
-#if VIEWS > 2
-  GATHER_VIEW(depth_tex2, 2)
-#endif
-#if VIEWS > 3
-  GATHER_VIEW(depth_tex3, 3)
-#endif
+  GATHER_ALL_VIEWS
   if (sum != before) {
     ESTIMATOR_STORE(accum, slot, sum);
   }

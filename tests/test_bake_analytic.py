@@ -145,17 +145,36 @@ def test_sigma_bound_catches_a_two_percent_normalization_error():
 
 @pytest.mark.parametrize("weighting", ["cosine", "uniform"])
 def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypatch, weighting):
-    """Testing 4 directions per compute dispatch (10 directions: two full batches and a batch
-    of 2 at the end) adds the same terms in the same order as one direction per dispatch."""
+    """Testing up to 16 or 4 directions per compute dispatch (10 directions: one batch of 10;
+    two batches of 4 and one of 2 padded with two empty slots) adds the same terms in the same
+    order as one direction per dispatch."""
     import hao_addon.gpu.bake_gather as bake_gather
     plane, sphere = sphere_on_plane()
     settings = BakeSettings(size=64, directions=10, method="gather", weighting=weighting, margin=0)
     maps = []
-    for per_dispatch in (4, 1):
-        monkeypatch.setattr(bake_gather, "VIEWS_PER_DISPATCH", per_dispatch)
-        maps.append(bake(plane, [sphere], settings, use_cache=False).ao)
+    for most, per_dispatch in ((16, 10), (4, 4), (1, 1)):
+        monkeypatch.setattr(bake_gather, "VIEWS_PER_DISPATCH", most)
+        result = bake(plane, [sphere], settings, use_cache=False)
+        assert result.stats["views_per_dispatch"] == per_dispatch
+        maps.append(result.ao)
     assert (maps[0] < 0.99).sum() > 100  # the sphere shadows the plane: the test sees occlusion
     np.testing.assert_array_equal(maps[0], maps[1])
+    np.testing.assert_array_equal(maps[0], maps[2])
+
+
+def test_gather_batch_size_follows_the_depth_map_budget():
+    """A dispatch's depth maps stay within DEPTH_BATCH_BYTES: 16 views up to 1024^2 pixels,
+    4 at 2048^2, one beyond; the directions split into batches of equal size (few padded
+    slots); max-distance bakes (depth lists) one per dispatch."""
+    from types import SimpleNamespace
+    import hao_addon.gpu.bake_gather as bake_gather
+
+    def per_dispatch(side, directions=256, max_distance=0.0):
+        settings = SimpleNamespace(max_distance=max_distance, directions=directions)
+        return bake_gather.views_per_dispatch(SimpleNamespace(max_view_side=side, settings=settings))
+    assert [per_dispatch(s) for s in (256, 1024, 1448, 2048, 4096)] == [16, 16, 8, 4, 1]
+    assert [per_dispatch(256, d) for d in (1, 8, 16, 20, 64, 96, 100)] == [1, 8, 16, 10, 16, 16, 15]
+    assert per_dispatch(256, max_distance=1.0) == 1
 
 
 @pytest.mark.parametrize("shading", ["face", "smooth"])
@@ -172,6 +191,9 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
     # A closed scene (the depth maps cull back faces): the sphere over a box.
     box = scenes.box((-3.0, -3.0, -1.0), (3.0, 3.0, -0.05))
     settings = BakeSettings(size=64, directions=32, method="gather", margin=0)
+    # Batches of 4 of the 32 directions: 16 directions span half the sphere, and nearly every
+    # bin faces one of them.
+    monkeypatch.setattr(bake_gather, "VIEWS_PER_DISPATCH", 4)
     maps, stats = [], []
     for binning in (True, False):
         monkeypatch.setattr(bake_gather, "NORMAL_BINNING", binning)
