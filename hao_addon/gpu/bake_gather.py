@@ -103,11 +103,11 @@ def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = Fals
 
 
 # Directions tested per compute dispatch: an entry and its sums are loaded once for all of
-# them. On the smooth bunny at 96 directions (llvmpipe) an entry's loads, decodes and store
-# cost about twice one facing direction's test, and one dispatch per direction spent 3.4 ms
-# per direction on texel tests, 4 per dispatch ~1.5 ms; 8 and 16 per dispatch cut the texel
-# tests' time by a further 10 % and 15 % (10.8M -> 6.1M -> 3.5M entry invocations; the union
-# of the batch's hemispheres grows slowly because batches are nearby directions). Each needs
+# them. On the smooth bunny (llvmpipe) an entry's loads, decodes and store cost about twice
+# one facing direction's test: one direction per dispatch spent 3.4 ms per direction on texel
+# tests, 4 per dispatch ~1.5 ms. At 64 directions 4, 8 and 16 per dispatch invoke 7.5M, 4.2M
+# and 2.3M entries (the union of a batch's hemispheres grows slowly: batches are nearby
+# directions) and the bake takes 1.56, 1.44 and 1.33 s (medians of 4, one process). Each needs
 # its own depth map, so a batch holds at most DEPTH_BATCH_BYTES of them: 16 views up to
 # 1024^2 pixels, 4 at 2048^2, 1 beyond. Each is a sampler of the compute shader, and OpenGL
 # guarantees 16 of those (GL_MAX_COMPUTE_TEXTURE_IMAGE_UNITS).
