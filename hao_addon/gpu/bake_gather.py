@@ -23,6 +23,8 @@ Sums are float32 per entry in a fixed direction order (deterministic), float64 p
 """
 from __future__ import annotations
 
+import math
+
 import gpu
 import numpy as np
 
@@ -164,7 +166,8 @@ def views_per_dispatch(plan: BakePlan) -> int:
         return 1
     most = int(np.clip(DEPTH_BATCH_BYTES // (4 * plan.max_view_side**2), 1, VIEWS_PER_DISPATCH))
     directions = max(1, plan.settings.directions)
-    return -(-directions // -(-directions // most))
+    batches = math.ceil(directions / most)
+    return math.ceil(directions / batches)
 
 
 # The accumulator image of an estimator's sums, by channel count (gpu_shaders/bake_estimator.glsl).
