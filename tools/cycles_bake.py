@@ -6,17 +6,18 @@ with sources, Selected to Active from them (the low-poly hidden from the render,
 does it)."""
 from __future__ import annotations
 
-import time
-
 import bpy
 import numpy as np
+
+from timing import median_seconds
 
 
 def cycles_ao_bake(obj: "bpy.types.Object", size: int, samples: list[int], seed: int = 0, sources: tuple = (),
                    cage_extrusion: float = 0.0, max_ray_distance: float = 0.0, warm_up: bool = False,
-                   log: bool = False) -> list[tuple[int, float, np.ndarray]]:
+                   log: bool = False, repeat_under_s: float = 0.0) -> list[tuple[int, float, np.ndarray]]:
     """[(samples, seconds, ao (size, size) float32, row 0 at v = 0)] for each sample count.
-    warm_up: one untimed 1-sample bake first (the session's one-off set-up)."""
+    warm_up: one untimed 1-sample bake first (the session's one-off set-up); bakes faster
+    than repeat_under_s seconds are repeated and their median time kept (timing.py)."""
     img = bpy.data.images.new(f"cycles_ao_{seed}", size, size, float_buffer=True)
     img.colorspace_settings.name = 'Non-Color'
     mat = bpy.data.materials.new("cycles_bake")
@@ -42,18 +43,17 @@ def cycles_ao_bake(obj: "bpy.types.Object", size: int, samples: list[int], seed:
     for source in sources:
         source.select_set(True)
 
-    def run(spp: int) -> float:
+    def run(spp: int, repeat_under: float) -> float:
         scene.cycles.samples = spp
-        t = time.perf_counter()
-        bpy.ops.object.bake(type='AO', use_clear=True, margin=0, use_selected_to_active=bool(sources),
-                            cage_extrusion=cage_extrusion, max_ray_distance=max_ray_distance)
-        return time.perf_counter() - t
+        return median_seconds(lambda: bpy.ops.object.bake(
+            type='AO', use_clear=True, margin=0, use_selected_to_active=bool(sources), cage_extrusion=cage_extrusion,
+            max_ray_distance=max_ray_distance), repeat_under)[0]
 
     if warm_up:
-        run(1)
+        run(1, 0.0)
     out = []
     for spp in samples:
-        seconds = run(spp)
+        seconds = run(spp, repeat_under_s)
         px = np.empty(size * size * 4, np.float32)
         img.pixels.foreach_get(px)
         out.append((spp, seconds, px.reshape(size, size, 4)[..., 0].copy()))
