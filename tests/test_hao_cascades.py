@@ -10,7 +10,7 @@ import numpy as np
 
 from hao_addon.core import scenes
 from hao_addon.core.hao.ao_pattern import cascade_march_reference
-from hao_addon.core.hao.cascades import SNAP_VOXELS, Focus, cascade_specs, contains
+from hao_addon.core.hao.cascades import MIN_REACH_VOXELS, SNAP_VOXELS, Focus, cascade_specs, contains
 from hao_addon.core.hao.view_scene import object_from_soup
 from hao_addon.core.hao.view_settings import ViewAOSettings
 from test_hao import low_res_samples, view
@@ -44,6 +44,21 @@ def test_cascades_nest_around_the_focus_and_stop_where_they_would_not_cover_it()
         np.testing.assert_allclose(steps, np.round(steps), atol=1e-9)
     assert cascade_specs(lo, hi, 128, 6, Focus((3.002, 1.001, 0.5), 1.0)) == specs
 
+
+
+def test_a_short_distance_adds_finer_cascades_until_it_spans_enough_voxels():
+    """Where d_max spans a few voxels, finer cascades are added around the focus even though
+    they cannot cover the whole focus area, until d_max spans MIN_REACH_VOXELS voxels."""
+    lo, hi = np.array([-20.0, -20.0, 0.0]), np.array([20.0, 20.0, 2.0])
+    wide = Focus((3.0, 1.0, 0.5), 15.0)  # no finer cascade (20 units) covers 30 units
+    assert len(cascade_specs(lo, hi, 128, 6, wide)) == 1
+    voxel = cascade_specs(lo, hi, 128, 1, None)[0].voxel
+    for reach, expected in ((2.0, 3), (5.0, 2), (MIN_REACH_VOXELS, 1), (0.0, 1)):  # voxels of one grid
+        specs = cascade_specs(lo, hi, 128, 6, wide, max_distance=reach * voxel)
+        assert len(specs) == expected, reach
+        assert 0.0 == reach or reach * voxel / specs[0].voxel >= MIN_REACH_VOXELS
+        assert contains(specs[0], np.array([3.0, 1.0, 0.5]))
+    assert len(cascade_specs(lo, hi, 128, 2, wide, max_distance=2.0 * voxel)) == 2  # the count still caps it
 
 def test_the_march_over_cascades_equals_its_numpy_twin(renderer):
     settings = ViewAOSettings(rays=16, max_distance=0.0, grid=64, filter_size=0, steps=1000)
@@ -100,3 +115,18 @@ def test_a_camera_move_or_a_distant_change_voxelizes_only_what_it_must(renderer)
     renderer.render(objects + [moved], *view((1.62, -2.21, 1.3), target=TARGET, width=160, height=120, fov=0.7),
                     settings)
     assert renderer.stats["cascades_voxelized"] == voxelized + 2
+
+
+def test_a_shorter_distance_alone_places_finer_cascades(renderer):
+    """d_max is part of the placement's key: changing only it re-places the cascades."""
+    floor = object_from_soup(scenes.grid_plane(4.0, 8, name="floor"), "floor")
+    box = object_from_soup(scenes.box((-0.3, -0.3, 0.0), (0.3, 0.3, 1.5), name="box"), "box")
+    settings = ViewAOSettings(rays=8, max_distance=0.0, grid=64)
+    camera = view((4.0, -5.5, 3.2), target=TARGET, width=160, height=120, fov=0.7)
+    renderer.render([floor, box], *camera, settings)
+    assert len(renderer.cascade_specs) == 1  # the view spans the floor
+    placed = renderer.stats["cascades"]
+    short = 2.0 * renderer.cascade_specs[0].voxel
+    renderer.render([floor, box], *camera, settings.with_(max_distance=short))
+    assert renderer.stats["cascades"] == placed + 1
+    assert len(renderer.cascade_specs) == 3 and short / renderer.cascade_specs[0].voxel >= MIN_REACH_VOXELS

@@ -59,7 +59,7 @@ PASSES = {
     "upload": PassSpec(("geometry",), (), "upload"),
     # Where the cascades go (core/hao/cascades.py): its key for the passes after it is the
     # placement it chose, which a small camera move leaves unchanged.
-    "cascades": PassSpec(("gbuffer", "region"), ("grid", "cascades", "march"), "cascades"),
+    "cascades": PassSpec(("gbuffer", "region"), ("grid", "cascades", "march", "max_distance"), "cascades"),
     # Not the upload: the grid's key names the cascades and the objects reaching into each
     # (one changing outside a user region, or outside a cascade, is not voxelized again).
     "voxelize": PassSpec(("cascades", "grid"), (), "voxelize"),
@@ -249,7 +249,7 @@ class HaoRenderer(util.GPUPass):
         settings = frame.settings
         count = settings.cascades if settings.march == "hierarchical" else 1
         focus = self._focus(frame) if count > 1 else None
-        self.cascade_specs = cascade_specs(*self.region, settings.grid, count, focus)
+        self.cascade_specs = cascade_specs(*self.region, settings.grid, count, focus, settings.max_distance)
         return self.cascade_specs
 
     def _focus(self, frame: Frame) -> Focus | None:
