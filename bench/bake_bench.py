@@ -13,8 +13,8 @@ cosine-weighted, unlimited-distance accessibility on face normals. A triangle-co
 (UV spheres, 2k to 500k triangles) checks how cost scales with geometry. Each method bakes
 once untimed first (shader compilation; Cycles' first-bake set-up), then every timed run is
 one bake as a user would run it; HAO's and Cycles' runs under 30 s alike are repeated three
-times and the median kept (tools/timing.py: the machine is shared). Both bakers run with margin 0 (no island growth; the error is
-measured inside the islands).
+times and the median kept (tools/timing.py: the machine is shared). Both bakers run with
+margin 0 (no island growth; the error is measured inside the islands).
 Smooth rows: the same meshes and layouts shaded smooth (Blender's corner normals), HAO and
 Cycles at lower sample counts against Cycles' own smooth bake at 1024 samples (all interior
 texels). High-to-low row: the bunny baked onto a 2 % Decimate copy of itself (xatlas UVs,

@@ -45,7 +45,6 @@ def test_cascades_nest_around_the_focus_and_stop_where_they_would_not_cover_it()
     assert cascade_specs(lo, hi, 128, 6, Focus((3.002, 1.001, 0.5), 1.0)) == specs
 
 
-
 def test_a_short_distance_adds_finer_cascades_until_it_spans_enough_voxels():
     """Where d_max spans a few voxels, finer cascades are added around the focus even though
     they cannot cover the whole focus area, until d_max spans MIN_REACH_VOXELS voxels."""

@@ -62,9 +62,9 @@ class ViewAOSettings:
                         description="voxels along the longest side of the region of interest (and of each cascade)")
     cascades: int = setting(DEFAULT_CASCADES, label="Cascades", minimum=1, maximum=MAX_CASCADES,
                             description="nested grids, each with half the voxel size of the one around it, placed "
-                                        "around what the view looks at while they cover it, or while the max distance "
-                                        f"spans fewer than {MIN_REACH_VOXELS:g} voxels (1 = one grid over the region; the fixed march "
-                                        "uses one)")
+                                        "around what the view looks at while they cover it, or while the max "
+                                        f"distance spans fewer than {MIN_REACH_VOXELS:g} voxels (1 = one grid over "
+                                        "the region; the fixed march uses one)")
     scale: int = setting(2, label="AO Scale", noun="scale", minimum=1, maximum=8,
                          description="AO is sampled at 1/scale of the image resolution per axis, then "
                                      "upsampled by the bilateral filter")
