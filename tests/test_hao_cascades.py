@@ -59,6 +59,7 @@ def test_a_short_distance_adds_finer_cascades_until_it_spans_enough_voxels():
         assert contains(specs[0], np.array([3.0, 1.0, 0.5]))
     assert len(cascade_specs(lo, hi, 128, 2, wide, max_distance=2.0 * voxel)) == 2  # the count still caps it
 
+
 def test_the_march_over_cascades_equals_its_numpy_twin(renderer):
     settings = ViewAOSettings(rays=16, max_distance=0.0, grid=64, filter_size=0, steps=1000)
     vp, w, h = view(EYE, target=TARGET, width=320, height=240, fov=0.7)

@@ -17,9 +17,10 @@ REPEAT_UNDER_S = 30.0
 def median_seconds(run: Callable[[], object], repeat_under_s: float = REPEAT_UNDER_S) -> tuple[float, object]:
     """(median wall seconds, the last run's result) of run(), repeated as described above."""
     times, result = [], None
-    while True:
+    for _ in range(REPEATS):
         t = time.perf_counter()
         result = run()
         times.append(time.perf_counter() - t)
-        if len(times) >= REPEATS or times[0] >= repeat_under_s:
-            return statistics.median(times), result
+        if times[0] >= repeat_under_s:
+            break
+    return statistics.median(times), result
