@@ -16,6 +16,7 @@ from typing import Callable, Generator
 
 import numpy as np
 
+from .core.blas_threads import single_threaded_blas
 from .core.geometry import TriangleSoup
 from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
@@ -96,7 +97,21 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         yield 1.0
         return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True},
                           cached.bent_normals, cached.tiles)
+    # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
+    with single_threaded_blas() as blas_threads:
+        result = yield from _bake_uncached(target, occluders, settings, high_to_low, vertex_target)
+    result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0)
+    if key is not None:
+        _CACHE[key] = result
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.popitem(last=False)
+    return result
 
+
+def _bake_uncached(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+                   high_to_low: HighToLow | None, vertex_target: VertexTarget | None
+                   ) -> Generator[float, None, BakeResult]:
+    """bake_steps without its cache: plan, run the baker's directions, finish the output."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     method = settings.method_for(high_to_low is not None)
     share = PROJECTION_PROGRESS_SHARE if high_to_low is not None else 0.0
@@ -143,14 +158,9 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
             ao, covered, filled = ao[0], covered[0], filled[0]
             bent = None if bent is None else bent[0]
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
-             "seconds": time.perf_counter() - t0, "cache_hit": False}
+             "cache_hit": False}
     tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
-    result = BakeResult(ao, covered, filled, stats, bent, tile_numbers)
-    if key is not None:
-        _CACHE[key] = result
-        while len(_CACHE) > _CACHE_SIZE:
-            _CACHE.popitem(last=False)
-    return result
+    return BakeResult(ao, covered, filled, stats, bent, tile_numbers)
 
 
 def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
