@@ -301,6 +301,15 @@ class GatherBaker(LightViewBaker):
         self.chunks = face_chunks(plan.drawn_positions)
         return self.chunks.order
 
+    def _light_view_batch(self, order: np.ndarray | None) -> "gpu.types.GPUBatch":
+        """Depth maps need the positions alone (a plan_batch's other attributes made llvmpipe
+        set up their interpolation for every averted face drawn); depth lists (max distance)
+        the plan_batch."""
+        if self.plan.settings.max_distance > 0.0:
+            return super()._light_view_batch(order)
+        positions = self.plan.drawn_positions
+        return positions_batch(positions if order is None else positions[order])
+
     def _target_batch(self) -> "gpu.types.GPUBatch | None":
         """The target with each face's normal bin, and the cones of the bins' normals (None
         when the receivers are uploaded: cpu_receivers)."""
@@ -455,7 +464,8 @@ class GatherBaker(LightViewBaker):
                     drawn = sum(end - first for first, end in facing[1])
                     self.stats["depth_faces_drawn"] += drawn
                     self.stats["depth_faces_skipped"] += len(self.face_bins.order) - drawn
-                depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing)
+                depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing,
+                              positions_only=True)
         self.pending.append(view)
         if len(self.pending) == self.slots or index == plan.settings.directions - 1:
             self._test_pending_views()

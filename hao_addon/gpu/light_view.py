@@ -155,8 +155,9 @@ def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = Fals
 
 
 def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
-                  averted_runs: list[tuple[int, int]] = (), facing=None) -> None:
-    """Clear the view's sub-rectangle and draw `batch` depth-only from the light.
+                  averted_runs: list[tuple[int, int]] = (), facing=None, positions_only: bool = False) -> None:
+    """Clear the view's sub-rectangle and draw `batch` depth-only from the light (a
+    positions_batch where positions_only, else a plan_batch: its attributes only cost).
 
     averted_runs: (first face, face count) runs of `batch` whose faces turned away from the
     light are drawn as well, after the whole batch with `culling` (see GatherBaker).
@@ -167,7 +168,7 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
     passes with image atomics: llvmpipe then skips their fragment shaders, side effects and
     all.) Call inside util.scoped_state()."""
     w, h = view.width, view.height
-    shader = depth_shader()
+    shader = depth_positions_shader() if positions_only else depth_shader()
     with framebuffer.bind():
         fb = gpu.state.active_framebuffer_get()
         gpu.state.viewport_set(0, 0, w, h)
@@ -230,7 +231,7 @@ class LightViewBaker(util.GPUPass):
         # Direction of each step (run_direction(step)); subclasses may reorder.
         self.direction_order = np.arange(plan.settings.directions)
         try:
-            self.all_batch = plan_batch(plan, with_occluders=True, order=self._draw_order())
+            self.all_batch = self._light_view_batch(self._draw_order())
             self.target_batch = self._target_batch()
             self._allocate()
         except BaseException:
@@ -240,6 +241,11 @@ class LightViewBaker(util.GPUPass):
     def _draw_order(self) -> np.ndarray | None:
         """(F,) permutation of target + occluder faces for the light-view batch, or None."""
         return None
+
+    def _light_view_batch(self, order: np.ndarray | None) -> "gpu.types.GPUBatch":
+        """What the light views draw (all_batch): target and occluders with their raster
+        attributes (plan_batch), in `order`."""
+        return plan_batch(self.plan, with_occluders=True, order=order)
 
     def _target_batch(self) -> "gpu.types.GPUBatch":
         return plan_batch(self.plan, with_occluders=False)
