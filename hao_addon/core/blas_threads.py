@@ -6,8 +6,8 @@ threads spin for a while after each call large enough to wake them. A bake's num
 small matrices (views, cones, a few million vertices times 3x3) that one thread does as fast,
 while the GPU driver needs the cores: with llvmpipe (Mesa's CPU OpenGL), on a 2-core machine,
 the spinning workers took 9.5 % of the CPU samples of a 96-direction gather of the smooth bunny
-(perf), and the bake ran 12 % faster with one BLAS thread (2.17 s against 2.47 s, the fastest
-of 4 runs each). Where no OpenBLAS is found (Accelerate on Apple silicon, a numpy built
+(perf), and the bake ran 12 % faster with one BLAS thread (2.20 s against 2.51 s, medians of
+8 runs interleaved in one process). Where no OpenBLAS is found (Accelerate on Apple silicon, a numpy built
 without it), nothing changes.
 """
 from __future__ import annotations

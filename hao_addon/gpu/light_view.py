@@ -187,7 +187,7 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
             positions_shader = depth_positions_shader()
             bind_light_view(positions_shader, view, 0, prepass=True)
             _draw_runs(facing[0], positions_shader, facing[1])
-            if averted_runs:
+            if averted_runs and shader is not positions_shader:
                 bind_light_view(shader, view, 0, prepass=True)
         if averted_runs:
             gpu.state.face_culling_set('FRONT')  # front = counter-clockwise = facing the light
