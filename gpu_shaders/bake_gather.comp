@@ -27,10 +27,13 @@ vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
   if (any(lessThan(px, vec2(0.0))) || any(greaterThanEqual(px, view_info.xy))) {
     return vec3(-1.0);
   }
-  /* The plane in clip space: depth (z / 2 + 1 / 2) changes by -n.xy / (n.z * size) per pixel. */
-  vec3 n = mat3(views.normal_proj[k]) * plane_normal;
-  float nz = (n.z < 0.0) ? min(n.z, -1e-12) : max(n.z, 1e-12);
-  vec2 slope = -n.xy / (nz * view_info.xy);
+  /* The plane's depth (z / 2 + 1 / 2) changes by plane_slope.xy * m.xy / m.z per pixel, m the
+   * plane normal through the view's linear part (bake_gather.py: for an orthographic view,
+   * S R with R a rotation, the clip-space normal is S^-2 m; the view_proj entries are
+   * loaded for light_pos already, so this costs no further loads). */
+  vec3 m = mat3(views.view_proj[k]) * plane_normal;
+  float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
+  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
   float depth = light_pos.z * 0.5 + 0.5;
   float plane_depth = depth + dot(slope, px + 0.5 - at);
   /* Only what lies nearer the light than the receiver can occlude it: where its plane runs

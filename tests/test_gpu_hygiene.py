@@ -94,8 +94,8 @@ def test_constants_reach_glsl_from_python_only():
         distinctive = len(repr(value)) > 4
         assert not any(f"#define {name}" in s or (distinctive and repr(value) in s) for s in sources.values()), name
     assert "[4]" not in sources["bake_gather_views.glsl"] and "GATHER_MAX_VIEWS" in sources["bake_gather_views.glsl"]
-    # std140 size of GatherViews: two arrays of GATHER_MAX_VIEWS mat4 (64 B) and two of vec4 (16 B).
+    # std140 size of GatherViews: one array of GATHER_MAX_VIEWS mat4 (64 B) and three of vec4 (16 B).
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
-    assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 64 + 16 + 16)
-    assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "normal_proj", "omega", "view_info")] == \
-        [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 128, GATHER_MAX_VIEWS * 144]
+    assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16 + 16)
+    assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "plane_slope", "omega", "view_info")] == \
+        [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80, GATHER_MAX_VIEWS * 96]
