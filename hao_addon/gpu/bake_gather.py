@@ -154,8 +154,9 @@ def plane_slope(view) -> np.ndarray:
     core/bake/views.light_basis), so the clip-space normal M^-T g is S^-2 m, and the slope
     -n.xy / (n.z * size) is -(s_z / s_xy)^2 / size * m.xy / m.z, with s_i the length of
     row i. Taking m from the view_proj entries the shader loads anyway, instead of a second
-    matrix, made the smooth bunny's texel tests about 15 % faster on llvmpipe (uniform loads
-    are repeated for every 8 lanes)."""
+    matrix's nine, made the smooth bunny's texel tests 17 % faster on llvmpipe (96
+    directions: 0.71 s against 0.85 s, medians of 8 interleaved; llvmpipe presumably repeats
+    uniform loads for every 8 lanes)."""
     rows = np.square(view.matrix[:3, :3].astype(np.float64)).sum(axis=1)
     return -rows[2] / (rows[:2] * np.array([view.width, view.height], np.float64))
 
