@@ -28,9 +28,9 @@ vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
     return vec3(-1.0);
   }
   /* The plane's depth (z / 2 + 1 / 2) changes by plane_slope.xy * m.xy / m.z per pixel, m the
-   * plane normal through the view's linear part (bake_gather.py: for an orthographic view,
-   * S R with R a rotation, the clip-space normal is S^-2 m; the view_proj entries are
-   * loaded for light_pos already, so this costs no further loads). */
+   * plane normal through the view's linear part (core/bake/views.OrthoView.plane_slope: for
+   * an orthographic view, S R with R a rotation, the clip-space normal is S^-2 m; the
+   * view_proj entries are loaded for light_pos already, so this costs no further loads). */
   vec3 m = mat3(views.view_proj[k]) * plane_normal;
   float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
   vec2 slope = views.plane_slope[k].xy * m.xy / mz;

@@ -430,3 +430,23 @@ def test_texel_sums_normalize_each_receiver_by_its_own_weight_sum():
     np.testing.assert_allclose(weight.ravel(), [2.0, 1.0, 0.0, 0.0])
     scaled = texel_sums(texel, sums * np.array([7.0, 0.01, 3.0, 5.0])[:, None], (2, 2))
     np.testing.assert_allclose(scaled, out)
+
+
+def test_plane_slope_is_the_clip_space_normals_slope():
+    """The gather's depth slope of a receiver's plane (OrthoView.plane_slope, used with
+    m = M g in plane_lookup) equals the slope -n.xy / (n.z * size) of the clip-space normal
+    n = M^-T g, for fitted views of every shape (non-square windows, any direction)."""
+    from hao_addon.core.bake.views import fit_views
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(400, 3)) * [3.0, 1.0, 0.2]  # a flat, elongated cloud: uneven windows
+    omegas = rng.normal(size=(12, 3))
+    omegas /= np.linalg.norm(omegas, axis=1, keepdims=True)
+    views = fit_views(omegas, points, [None] * 12, 0.01, rng.uniform(size=(12, 2)), 4096)
+    assert len({(v.width, v.height) for v in views}) > 6
+    for view in views:
+        linear = view.matrix[:3, :3].astype(np.float64)
+        normals = rng.normal(size=(20, 3))
+        clip = normals @ np.linalg.inv(linear)  # rows: (M^-T g)^T
+        expected = -clip[:, :2] / (clip[:, 2:] * [view.width, view.height])
+        m = normals @ linear.T
+        np.testing.assert_allclose(view.plane_slope() * m[:, :2] / m[:, 2:], expected, rtol=1e-5, atol=1e-12)

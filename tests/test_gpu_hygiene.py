@@ -4,7 +4,6 @@ compiles, registration touches no GPU, and nothing is left behind."""
 from __future__ import annotations
 
 import gpu
-import numpy as np
 import pytest
 
 from hao_addon.gpu import shaders
@@ -100,24 +99,3 @@ def test_constants_reach_glsl_from_python_only():
     assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16 + 16)
     assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "plane_slope", "omega", "view_info")] == \
         [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80, GATHER_MAX_VIEWS * 96]
-
-
-def test_plane_slope_is_the_clip_space_normals_slope():
-    """The gather's depth slope of a receiver's plane (bake_gather.plane_slope, used with
-    m = M g in plane_lookup) equals the slope -n.xy / (n.z * size) of the clip-space normal
-    n = M^-T g, for fitted views of every shape (non-square windows, any direction)."""
-    from hao_addon.core.bake.views import fit_views
-    from hao_addon.gpu.bake_gather import plane_slope
-    rng = np.random.default_rng(3)
-    points = rng.normal(size=(400, 3)) * [3.0, 1.0, 0.2]  # a flat, elongated cloud: uneven windows
-    omegas = rng.normal(size=(12, 3))
-    omegas /= np.linalg.norm(omegas, axis=1, keepdims=True)
-    views = fit_views(omegas, points, [None] * 12, 0.01, rng.uniform(size=(12, 2)), 4096)
-    assert len({(v.width, v.height) for v in views}) > 6
-    for view in views:
-        linear = view.matrix[:3, :3].astype(np.float64)
-        normals = rng.normal(size=(20, 3))
-        clip = normals @ np.linalg.inv(linear)  # rows: (M^-T g)^T
-        expected = -clip[:, :2] / (clip[:, 2:] * [view.width, view.height])
-        m = normals @ linear.T
-        np.testing.assert_allclose(plane_slope(view) * m[:, :2] / m[:, 2:], expected, rtol=1e-5, atol=1e-12)

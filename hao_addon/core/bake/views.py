@@ -29,6 +29,15 @@ class OrthoView:
     depth_near: float
     depth_far: float
 
+    def plane_slope(self) -> np.ndarray:
+        """(2,) float64 c: a plane of normal g has depth (clip z / 2 + 1 / 2) slope
+        c * m.xy / m.z per pixel in this view, m = M g for the matrix's linear part M. M = S R
+        (scales S times the rotation of light_basis), so the clip-space normal M^-T g is
+        S^-2 m, and its slope -n.xy / (n.z * size) is -(s_z / s_xy)^2 / size * m.xy / m.z,
+        s_i the length of row i (gpu_shaders/bake_gather.comp, plane_lookup)."""
+        rows = np.square(self.matrix[:3, :3].astype(np.float64)).sum(axis=1)
+        return -rows[2] / (rows[:2] * np.array([self.width, self.height], np.float64))
+
 
 def light_basis(omega: np.ndarray) -> np.ndarray:
     """Rows u, v, w with w = omega and u x v = w (so front faces stay counter-clockwise)."""
