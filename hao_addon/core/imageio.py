@@ -65,9 +65,22 @@ def check_writable(path: str | Path, width: int, height: int, channels: int, sou
     needed = file_bytes_estimate(path, width, height, channels)
     free = shutil.disk_usage(folder).free
     if needed > free:
-        raise BakeInputError(f"cannot write '{path}': it needs up to {needed / 2**20:.1f} MiB, "
-                             f"the disk has {free / 2**20:.1f} MiB free")
+        raise BakeInputError(f"cannot write '{path}': it needs up to {byte_size(needed)}, "
+                             f"the disk has {byte_size(free)} free")
     return path
+
+
+def byte_size(count: int) -> str:
+    """A byte count in the largest binary unit that keeps it at 1 or more ('12 bytes',
+    '3.5 KiB', '1.2 GiB'): a free space of 40 KiB is not '0.0 MiB'."""
+    if count < 1024:
+        return f"{count} bytes"
+    value = float(count)
+    for unit in ("KiB", "MiB", "GiB", "TiB"):
+        value /= 1024.0
+        if value < 1024.0 or unit == "TiB":
+            return f"{value:.1f} {unit}"
+    raise AssertionError("unreachable")
 
 
 def _can_create_in(folder: Path) -> bool:
@@ -93,14 +106,90 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         # mkstemp creates 0600; give the file the permissions a plain open() would.
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+class StagedFiles:
+    """Several files written all or none. ``write`` puts each file's bytes under a temporary
+    name beside its target; ``commit`` renames them all into place, keeping any file it
+    replaces under a hidden backup name until ``release`` (drop the backups) or ``rollback``
+    (put the earlier files back, remove the new ones). ``discard`` removes what was staged.
+    A bake that fails after its maps are in place (an image that cannot be stored, a glTF
+    export) thus leaves the folder as it found it."""
+
+    def __init__(self) -> None:
+        self._staged: list[tuple[Path, str]] = []  # (target, temporary file)
+        self._placed: list[tuple[Path, str | None]] = []  # (target, backup of the file it replaced)
+
+    @property
+    def paths(self) -> list[str]:
+        """The targets staged or placed, in the order written."""
+        return [str(target) for target, _tmp in self._staged] + [str(target) for target, _b in self._placed]
+
+    def write_bytes(self, path: str | Path, data: bytes) -> None:
+        path = Path(path)
+        if not path.parent.is_dir():
+            raise OSError(f"output folder does not exist: {path.parent}")
+        fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
+        self._staged.append((path, tmp))  # first: removed by discard() even if the write fails
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())
+
+    def write_image(self, path: str | Path, image: np.ndarray) -> None:
+        """(H, W) or (H, W, 4) to .png (16-bit) or .exr (32-bit float), as write_ao_file."""
+        self.write_bytes(path, encode_image(path, image))
+
+    def commit(self) -> list[str]:
+        """Rename every staged file into place; returns their paths. On failure, rolls back."""
+        try:
+            while self._staged:
+                target, tmp = self._staged[0]
+                backup = None
+                if target.exists():
+                    backup = tempfile.mktemp(prefix=TEMP_PREFIX, suffix=".bak", dir=target.parent)
+                    os.link(target, backup)  # the earlier file stays reachable until release()
+                self._placed.append((target, backup))
+                self._staged.pop(0)
+                os.replace(tmp, target)
+        except BaseException:
+            self.rollback()
+            raise
+        return [str(target) for target, _b in self._placed]
+
+    def release(self) -> None:
+        """Keep the new files: drop the backups of the ones they replaced."""
+        for _target, backup in self._placed:
+            if backup is not None and os.path.lexists(backup):
+                os.unlink(backup)
+        self._placed.clear()
+
+    def rollback(self) -> None:
+        """Put back what commit replaced, remove what it added, and discard what is staged."""
+        for target, backup in reversed(self._placed):
+            if backup is not None and os.path.lexists(backup):
+                os.replace(backup, target)
+            elif backup is None and os.path.lexists(target):
+                os.unlink(target)
+        self._placed.clear()
+        self.discard()
+
+    def discard(self) -> None:
+        for _target, tmp in self._staged:
+            if os.path.lexists(tmp):
+                os.unlink(tmp)
+        self._staged.clear()
+
+
+def _umask() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
 
 
 def png16_bytes(image: np.ndarray) -> bytes:
@@ -162,10 +251,15 @@ def exr32_bytes(image: np.ndarray) -> bytes:
     return header + offsets + rows.tobytes()
 
 
-def write_ao_file(path: str | Path, image: np.ndarray) -> None:
-    """Write (H, W) accessibility, or (H, W, 4) RGBA, to .png (16-bit) or .exr (32-bit
-    float), atomically."""
+def encode_image(path: str | Path, image: np.ndarray) -> bytes:
+    """The file bytes of (H, W) accessibility, or (H, W, 4) RGBA, for path's format."""
     fmt = format_for_path(path)
     if not np.isfinite(image).all():
         raise ValueError("refusing to write an AO map containing NaN or Inf")
-    atomic_write_bytes(Path(path), png16_bytes(image) if fmt == "PNG" else exr32_bytes(image))
+    return png16_bytes(image) if fmt == "PNG" else exr32_bytes(image)
+
+
+def write_ao_file(path: str | Path, image: np.ndarray) -> None:
+    """Write (H, W) accessibility, or (H, W, 4) RGBA, to .png (16-bit) or .exr (32-bit
+    float), atomically."""
+    atomic_write_bytes(Path(path), encode_image(path, image))

@@ -229,7 +229,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     for occ in occluders:
         _check_finite(occ)
     if high_to_low is not None:
-        check_high_to_low(target, high_to_low)
+        check_high_to_low(target, high_to_low, settings.cage_extrusion)
         occluders = [*high_to_low.sources, *occluders]
 
     normals, areas = face_normals_areas(target.positions)

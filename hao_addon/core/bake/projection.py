@@ -36,6 +36,10 @@ from .terminator import smooth_surface_lift
 # Warn when more than this fraction of the sampled texels found no high-poly surface (they
 # are filled from their neighbours, as margin).
 MISSED_TEXELS_WARNING = 0.01
+# A ray must start where float32 positions (the GPU's) still resolve this share of the mesh's
+# size: the spacing of float32 numbers at the start, |p| + extrusion, is |p| x 2^-23.
+EXTRUSION_RESOLUTION = 1e-4
+FLOAT32_SPACING = 2.0 ** -23
 
 
 @dataclass
@@ -56,8 +60,10 @@ class HighToLow:
     low_linear: np.ndarray | None = None
 
 
-def check_high_to_low(target: TriangleSoup, request: HighToLow) -> None:
-    """Raise BakeInputError for a request that cannot be baked."""
+def check_high_to_low(target: TriangleSoup, request: HighToLow, cage_extrusion: float = 0.0) -> None:
+    """Raise BakeInputError for a request that cannot be baked (cage_extrusion: the setting,
+    refused where float32 ray starts would lose the mesh's detail)."""
+    check_extrusion(target, request, cage_extrusion)
     if not request.sources or not any(s.face_count for s in request.sources):
         raise BakeInputError(f"Selected to Active needs a high-poly source with faces besides '{target.name}'")
     for source in request.sources:
@@ -70,6 +76,28 @@ def check_high_to_low(target: TriangleSoup, request: HighToLow) -> None:
                                  f"low-poly with moved vertices")
         if not np.isfinite(request.cage).all():
             raise BakeInputError(f"the cage '{request.cage_name}' has NaN or infinite vertex positions")
+
+
+def max_extrusion(target: TriangleSoup, request: HighToLow) -> float:
+    """The largest cage extrusion whose ray starts float32 positions hold to EXTRUSION_RESOLUTION
+    of the low-poly's size (bounding-box diagonal; the object's scale included, as Blender
+    extrudes in object space)."""
+    low, high = target.positions.min(axis=(0, 1)), target.positions.max(axis=(0, 1))
+    size = float(np.linalg.norm(high - low))
+    reach = float(np.abs(target.positions).max())
+    gain = 1.0 if request.low_linear is None else float(np.linalg.norm(request.low_linear, 2))
+    return max(size * EXTRUSION_RESOLUTION / FLOAT32_SPACING - reach, 0.0) / max(gain, 1e-30)
+
+
+def check_extrusion(target: TriangleSoup, request: HighToLow, cage_extrusion: float) -> None:
+    """Refuse a cage extrusion beyond max_extrusion (with a cage object it is not used)."""
+    if request.cage is not None or cage_extrusion <= 0.0:
+        return
+    limit = max_extrusion(target, request)
+    if cage_extrusion > limit:
+        raise BakeInputError(f"a cage extrusion of {cage_extrusion:g} is too far for '{target.name}': float32 ray "
+                             f"starts there cannot resolve a mesh of its size; use at most {limit:.4g} (or a "
+                             f"cage object)")
 
 
 def ray_starts(target: TriangleSoup, request: HighToLow, face: np.ndarray, bary: np.ndarray,
@@ -216,6 +244,10 @@ def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings
     sampled = int((np.bincount(texel, minlength=cells) > 0).sum())
     missed = sampled - int((np.bincount(receivers.texel, minlength=cells) > 0).sum())
     warning = None
+    if sampled and missed == sampled:
+        raise BakeInputError(f"none of the {sampled} texels of '{target.name}' found a high-poly surface: check "
+                             f"that the high-poly lies on the low-poly, and raise the cage extrusion or the max "
+                             f"ray distance, or use a cage object")
     if sampled and missed > MISSED_TEXELS_WARNING * sampled:
         warning = (f"{missed} of {sampled} texels of '{target.name}' ({100.0 * missed / sampled:.1f} %) found no "
                    f"high-poly surface and were filled from their neighbours: raise the cage extrusion or the max "

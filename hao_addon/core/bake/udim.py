@@ -3,7 +3,8 @@
 per used tile (tile 1001 + u + 10 v for the square [u, u + 1) x [v, v + 1), u in 0..9),
 each with its own margins, as Blender's tiled images and Cycles' bake hold them.
 
-A layout is tiled only when every triangle lies inside one tile and some tile is not 1001;
+A layout is tiled only when every triangle lies inside one tile of Blender's grid (1001 to
+2000) and some tile is not 1001;
 a triangle that crosses a tile border keeps the single-tile bake of 0..1 and its warning
 about UVs outside it (core/bake/uv_checks.py), as before UDIM support.
 """
@@ -16,6 +17,8 @@ import numpy as np
 
 FIRST_TILE = 1001
 TILES_PER_ROW = 10
+# Blender's tiles end at 2000 (v below 100): a layout reaching past it is not tiled.
+TILE_ROWS = 100
 # UVs this far past a tile's border still lie in it (float rounding of islands packed to
 # the edge).
 BORDER_SLACK = 1e-6
@@ -59,8 +62,8 @@ def udim_layout(uvs: np.ndarray) -> UdimLayout | None:
     inside = ((uvs >= corner[:, None, :] - BORDER_SLACK) & (uvs <= corner[:, None, :] + 1 + BORDER_SLACK)).all(axis=(1, 2))
     if not inside.all() or (corner == 0).all():
         return None
-    if corner.min() < 0 or corner[:, 0].max() >= TILES_PER_ROW:
-        return None  # outside the UDIM grid (u in 0..9, v >= 0): not a tiled layout
+    if corner.min() < 0 or corner[:, 0].max() >= TILES_PER_ROW or corner[:, 1].max() >= TILE_ROWS:
+        return None  # outside the UDIM grid (u in 0..9, v in 0..99): not a tiled layout
     numbers = tile_number(corner[:, 0], corner[:, 1])
     tiles, face_tile = np.unique(numbers, return_inverse=True)
     offsets = np.stack([(tiles - FIRST_TILE) % TILES_PER_ROW, (tiles - FIRST_TILE) // TILES_PER_ROW], axis=1)

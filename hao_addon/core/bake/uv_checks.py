@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """UV layouts that bake, but not as the user probably expects: islands that overlap (their
 texels receive the average of several surface points) and UVs outside the 0..1 tile (those
-parts are not baked). Both are reported as warnings, as Cycles users would want to know."""
+parts are not baked), and triangles of zero UV area (their faces get no texels). Each is
+reported as a warning, as Cycles users would want to know."""
 from __future__ import annotations
 
 import hashlib
@@ -13,6 +14,12 @@ import numpy as np
 CHECK_SIDE = 512
 # Fractions below these are rounding at shared edges, not a layout problem.
 OVERLAP_WARN_FRACTION = 1e-3
+# UV triangles of zero area (collapsed to a line or a point) get no texel: warned about above
+# this share of the triangles (a few slivers are common in real meshes, most is a broken map).
+ZERO_AREA_WARN_FRACTION = 0.01
+# A UV triangle whose doubled area is below this is taken as zero (float32 UVs of a 1-unit
+# tile resolve about 6e-8; a texel of the largest map, 16384^2, is 3.7e-9 of the tile).
+ZERO_UV_AREA = 1e-12
 CHUNK_CANDIDATES = 1 << 21
 
 
@@ -65,6 +72,10 @@ def uv_layout_warnings(uvs: np.ndarray, size: int, name: str) -> tuple[list[str]
     if outside:
         warnings.append(f"'{name}': {outside} of {len(uvs)} UV triangles reach outside the 0..1 UV "
                         f"tile; those parts are not baked")
+    zero = counts["uv_triangles_zero_area"]
+    if zero > ZERO_AREA_WARN_FRACTION * len(uvs):
+        warnings.append(f"'{name}': {zero} of {len(uvs)} UV triangles have zero area in the UV map; those "
+                        f"faces get no texels: unwrap them")
     if fraction > OVERLAP_WARN_FRACTION:
         warnings.append(f"'{name}': UV islands overlap on {fraction * 100:.1f} % of the baked texels; "
                         f"those texels get the average of the overlapping surfaces")
@@ -85,7 +96,10 @@ def _layout_counts(uvs: np.ndarray, size: int) -> dict:
     outside = ((uvs < -tolerance) | (uvs > 1.0 + tolerance)).any(axis=(1, 2))
     hits = texel_centre_hits(uvs, min(size, CHECK_SIDE))
     covered = int((hits > 0).sum())
+    edges = uvs[:, 1:] - uvs[:, :1]
+    doubled_area = np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
     counts = dict(uv_triangles_outside_tile=int(outside.sum()),
+                  uv_triangles_zero_area=int((doubled_area < ZERO_UV_AREA).sum()),
                   uv_overlap_fraction=int((hits > 1).sum()) / covered if covered else 0.0)
     _CACHE[key] = counts
     while len(_CACHE) > _CACHE_SIZE:
