@@ -53,8 +53,11 @@ _CACHE: "OrderedDict[str, BakeResult]" = OrderedDict()
 _CACHE_SIZE = 8
 
 
-def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-            high_to_low: HighToLow | None, vertex_target: VertexTarget | None) -> str:
+def bake_key(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+             high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> str:
+    """A digest of everything a bake's result depends on (geometry, UVs, normals, settings):
+    equal keys bake equal maps. The cache's key, and a frame sequence's test for a frame
+    that repeats an earlier one."""
     h = hashlib.blake2b(digest_size=20)
     h.update(repr(settings.cache_key()).encode())
     if vertex_target is not None:
@@ -75,6 +78,14 @@ def _digest(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeS
     return h.hexdigest()
 
 
+def _renamed(warnings: list[str], old: str | None, new: str) -> list[str]:
+    """A cached bake's warnings for the target asking now: the cache is keyed by geometry, not
+    by name, and every warning names its object in quotes ('Spot')."""
+    if not old or old == new:
+        return list(warnings)
+    return [w.replace(f"'{old}'", f"'{new}'") for w in warnings]
+
+
 def clear_cache() -> None:
     _CACHE.clear()
 
@@ -90,17 +101,19 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
     """
     t0 = time.perf_counter()
-    key = _digest(target, occluders, settings, high_to_low, vertex_target) if use_cache else None
+    key = bake_key(target, occluders, settings, high_to_low, vertex_target) if use_cache else None
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
         yield 1.0
-        return BakeResult(cached.ao, cached.covered, cached.filled, {**cached.stats, "cache_hit": True},
-                          cached.bent_normals, cached.tiles)
+        stats = {**cached.stats, "cache_hit": True, "target_name": target.name,
+                 "warnings": _renamed(cached.stats.get("warnings", []), cached.stats.get("target_name"), target.name)}
+        return BakeResult(cached.ao, cached.covered, cached.filled, stats, cached.bent_normals, cached.tiles)
     # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
     with single_threaded_blas() as blas_threads:
         result = yield from _bake_uncached(target, occluders, settings, high_to_low, vertex_target)
-    result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0)
+    result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
+                        target_name=target.name)
     if key is not None:
         _CACHE[key] = result
         while len(_CACHE) > _CACHE_SIZE:
@@ -180,4 +193,5 @@ def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSett
         steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
 
 
-__all__ = ["BakeInputError", "BakeResult", "HighToLow", "VertexTarget", "bake", "bake_steps", "clear_cache"]
+__all__ = ["BakeInputError", "BakeResult", "HighToLow", "VertexTarget", "bake", "bake_key", "bake_steps",
+           "clear_cache"]

@@ -65,6 +65,12 @@ class ModalBakeRunner:
             self.workspace.status_text_set(None)
 
 
+def cancelled_note(job: BakeJob) -> str:
+    """What a cancelled or failed bake left: nothing, or a sequence's finished frames."""
+    kept = job.written_note()
+    return f"{kept}, nothing of the frame it stopped" if kept else "nothing was changed"
+
+
 class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
     """Bake ambient occlusion of the selected meshes into image textures on the GPU"""
 
@@ -119,7 +125,7 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
             job.commit()
         except USER_ERRORS as exc:
             job.cancel()
-            self.report({'ERROR'}, f"Bake AO failed: {exc}")
+            self.report({'ERROR'}, f"Bake AO failed: {exc}" + (f" ({job.written_note()})" if job.written else ""))
             return {'CANCELLED'}
         except BaseException:
             job.cancel()
@@ -143,8 +149,9 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
 
     def modal(self, context, event):
         if event.type == 'ESC':
+            job = self._runner.job
             self._stop(context, cancelled=True)
-            self.report({'WARNING'}, "Bake AO cancelled: nothing was changed")
+            self.report({'WARNING'}, f"Bake AO cancelled: {cancelled_note(job)}")
             return {'CANCELLED'}
         if event.type != 'TIMER':
             return {'RUNNING_MODAL'}  # keep the scene still while baking

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 import subprocess
 import sys
 from pathlib import Path
@@ -44,14 +45,28 @@ def test_each_frame_of_the_walk_equals_a_single_bake_at_that_frame(gpu_context, 
     assert scene.frame_current == 3  # restored
     assert sorted(os.listdir(tmp_path)) == [f"man_{f:04d}.exr" for f in frames]
     assert [e["frame"] for e in job.frame_results] == frames and not any(e["reused"] for e in job.frame_results)
-    maps = [e["results"][0][2].ao for e in job.frame_results]
-    assert np.abs(maps[0] - maps[1]).max() > 0.05  # the walk changes the occlusion
-    for frame, baked in zip(frames, maps):
+    assert [e["outputs"] for e in job.frame_results] == [[str(tmp_path / f"man_{f:04d}.exr")] for f in frames]
+    files = [(tmp_path / f"man_{f:04d}.exr").read_bytes() for f in frames]
+    assert files[0] != files[1]  # the walk changes the occlusion
+    single_dir = tmp_path / "single"
+    single_dir.mkdir()
+    for frame, baked in zip(frames, files):
         clear_cache()  # a fresh bake, not the sequence's cached one
         scene.frame_set(frame)
-        single = BakeJob(BakeRequest([man], SETTINGS), bpy.context.evaluated_depsgraph_get)
-        single.run()
-        np.testing.assert_array_equal(single.results[0][2].ao, baked)
+        run_job(BakeRequest([man], SETTINGS, filepath=str(single_dir / f"{frame}.exr")))
+        assert (single_dir / f"{frame}.exr").read_bytes() == baked  # 32-bit float: the same map
+
+
+def test_a_sequence_keeps_no_frame_maps_in_memory(gpu_context, tmp_path):
+    """Each frame is written when it is done and its maps dropped: what the job holds after N
+    frames is one frame's maps (its last results), whatever N (issue 28: +8 MB a frame)."""
+    man = cesium_man()
+    job = run_job(BakeRequest([man], replace(SETTINGS, bent_normals=True), filepath=str(tmp_path / "{frame}.png"),
+                              bent_filepath=str(tmp_path / "bent_{frame}.png"), frames=[1, 5, 9, 13]))
+    assert len(os.listdir(tmp_path)) == 8
+    held = [value for entry in job.frame_results for value in entry.values()]
+    assert not any(isinstance(v, np.ndarray) or hasattr(v, "ao") for v in held)  # no maps per frame
+    assert len(job.results) == 1 and job.bent_images == {}  # the last frame's result only
 
 
 def test_a_static_mesh_over_ten_frames_bakes_once(gpu_context, tmp_path):
@@ -66,10 +81,11 @@ def test_a_static_mesh_over_ten_frames_bakes_once(gpu_context, tmp_path):
     assert all((tmp_path / f"m_{f:04d}.png").read_bytes() == first for f in range(2, 11))
 
 
-def test_cancelling_a_sequence_restores_the_frame_and_writes_nothing(gpu_context, tmp_path):
+def test_cancelling_a_sequence_restores_the_frame_and_keeps_the_finished_frames(gpu_context, tmp_path):
     man = cesium_man()
     scene = bpy.context.scene
     scene.frame_set(4)
+    clear_cache()
     job = BakeJob(BakeRequest([man], SETTINGS, filepath=str(tmp_path / "{frame}.png"), frames=[1, 2, 3]),
                   bpy.context.evaluated_depsgraph_get)
     steps = job.steps()
@@ -78,7 +94,10 @@ def test_cancelling_a_sequence_restores_the_frame_and_writes_nothing(gpu_context
     assert scene.frame_current != 4
     steps.close()
     job.cancel()
-    assert scene.frame_current == 4 and os.listdir(tmp_path) == []
+    # Frame 1 finished and stays (complete, listed); nothing of frame 2, no temporary file.
+    assert scene.frame_current == 4 and os.listdir(tmp_path) == ["0001.png"]
+    assert job.written == [str(tmp_path / "0001.png")]
+    assert job.written_note() == "frame 1 (1 file) is written"
 
 
 def test_cli_frames_and_report(tmp_path):

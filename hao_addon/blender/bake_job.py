@@ -1,23 +1,29 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """A bake of one or more Blender objects, driven step by step (for progress and cancel).
 
-Nothing the user can see changes until ``commit``: files are written atomically first, then
-image datablocks and material nodes. The only change made earlier is a new ``AO_UV`` map
-for meshes without UVs (the evaluated mesh must carry it); ``cancel`` removes it again.
+Nothing the user can see changes until ``commit``: files are written all or none first (each
+staged beside its target, then all renamed into place), then image datablocks and material
+nodes; a failure there puts the earlier files back. The only change made earlier is a new
+``AO_UV`` map for meshes without UVs (the evaluated mesh must carry it); ``cancel`` removes
+it again. A frame sequence is the exception, by design: each frame's files are written as
+soon as that frame is baked (memory stays flat in the frame count, and an interrupted
+sequence keeps its finished frames, listed in ``written``).
 """
 from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Generator
 
 import bpy
 import numpy as np
 
 from .. import compat
-from ..bake import BakeResult, bake_steps
-from ..core.imageio import check_writable, write_ao_file
+from ..bake import BakeResult, bake_key, bake_steps
+from ..core.imageio import StagedFiles, check_writable
+from ..core.output_files import check_output_files
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
@@ -75,6 +81,11 @@ class BakeRequest:
     bent_convention: str = "opengl"
     texture_set: bool = False
     frames: list | None = None
+    # What else the caller reads and writes, as (path, what) pairs, so that one check
+    # (core/output_files.py) sees every file of the run: the CLI's --json report, --gltf-out,
+    # a colour bake's mesh file, high-poly files, a batch's other inputs and earlier outputs.
+    extra_inputs: list = field(default_factory=list)
+    extra_outputs: list = field(default_factory=list)
 
     @property
     def to_color_attribute(self) -> bool:
@@ -151,20 +162,51 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
     if request.bent_space not in SPACES or request.bent_convention not in CONVENTIONS:
         raise BakeInputError(f"bent normals: space must be one of {SPACES}, convention one of {CONVENTIONS}")
-    writers: dict[str, str] = {}
     size = request.settings.size
-    for obj in request.targets[:1] if request.texture_set else request.targets:  # a set's files are shared
-        for filepath, channels in ((request.filepath, 1), (request.bent_filepath, 4)):
+    for obj in _file_owners(request):
+        for _kind, filepath, _what, channels in output_kinds(request):
             path = output_path_for(request, obj, filepath)
-            if not path:
+            if path:
+                check_writable(example_path(path, (request.frames or [0])[0]), size, size, channels,
+                               source=request.source_path or None)
+    check_output_files(planned_files(request), input_files(request))
+
+
+def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
+    """The image files a request writes per target: (kind, path pattern, what, channels)."""
+    return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4))
+
+
+def _file_owners(request: BakeRequest) -> list:
+    """The targets whose files are written: every target, or a texture set's first (shared)."""
+    return request.targets[:1] if request.texture_set else request.targets
+
+
+def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple[str, str]]:
+    """Every file the request writes, as (path, what): each target's maps and bent normals
+    (each frame's, each UDIM tile's where tiles {label: tile numbers} is given), then the
+    caller's extra_outputs."""
+    out = []
+    for obj in _file_owners(request):
+        label = TEXTURE_SET_NAME if request.texture_set else obj.name
+        for _kind, filepath, what, _channels in output_kinds(request):
+            if not filepath:
                 continue
-            if path in writers:
-                raise BakeInputError(f"'{writers[path]}' and '{obj.name}' would both be saved as '{path}': "
-                                     f"rename one of them" if writers[path] != obj.name else
-                                     f"the AO map and the bent normals of '{obj.name}' would both be saved as "
-                                     f"'{path}'")
-            writers[path] = obj.name
-            check_writable(example_path(path), size, size, channels, source=request.source_path or None)
+            for frame in request.frames or [None]:
+                path = output_path_for(request, obj, filepath, frame)
+                at = "" if frame is None else f" at frame {frame}"
+                numbers = (tiles or {}).get(label)
+                out += ([(path, f"{what} of '{label}'{at}")] if not numbers else
+                        [(tile_path(path, t), f"{what} of '{label}' tile {t}{at}") for t in numbers])
+    return out + [tuple(entry) for entry in request.extra_outputs]
+
+
+def input_files(request: BakeRequest) -> list[tuple[str, str]]:
+    """The files the run reads, as (path, what): the scene's file and the caller's extra_inputs."""
+    source = [(request.source_path, "the input file")] if request.source_path else []
+    if bpy.data.filepath:
+        source.append((bpy.data.filepath, "the open .blend file"))
+    return source + [tuple(entry) for entry in request.extra_inputs]
 
 
 def _validate_frames(request: BakeRequest) -> None:
@@ -180,6 +222,10 @@ def _validate_texture_set(request: BakeRequest) -> None:
     if request.to_color_attribute or request.high_poly is not None:
         raise BakeInputError("a texture set bakes the objects' own surfaces into one image: not with a colour "
                              "attribute or Selected to Active")
+    for obj in request.targets:
+        if obj.type == 'MESH' and not obj.data.uv_layers:
+            raise BakeInputError(f"'{obj.name}' has no UV map: a texture set bakes each object's own UVs into one "
+                                 f"image, so lay out its islands beside the other objects' first")
     if request.settings.bent_normals and request.bent_space == "object":
         raise BakeInputError("object-space bent normals of a texture set would mix the objects' spaces: use "
                              "tangent space")
@@ -234,10 +280,16 @@ class BakeJob:
         self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
-        self.written: list[str] = []  # the files commit() wrote
+        self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
-        # A frame sequence: per frame {frame, seconds, reused, results, bent_images}.
+        # A frame sequence: per frame {frame, seconds, reused, outputs} (its maps are written
+        # and dropped as each frame finishes).
         self.frame_results: list[dict] = []
+        self._staged: StagedFiles | None = None  # commit(hold=True)'s files until release()
+        # A sequence's bakes by (label, bake_key): (the frame whose files hold it, its stats and
+        # tiles). A frame that repeats one copies those files: no maps are kept in memory.
+        self._frame_bakes: dict[tuple[str, str], tuple[int, dict, tuple | None]] = {}
+        self._copies: dict[str, int] = {}  # this frame's labels -> the earlier frame to copy
         self.committed: list[bpy.types.Image] = []
         self.finished = False
         self.unwrap_seconds = 0.0
@@ -312,9 +364,10 @@ class BakeJob:
                 t0 = time.perf_counter()
                 self.results = []
                 yield from self._bake_frame(uv_names, k / len(req.frames), 1.0 / len(req.frames), frame)
+                outputs = self._write_frame(frame)
                 self.frame_results.append(dict(frame=frame, seconds=round(time.perf_counter() - t0, 4),
                                                reused=all(r.stats.get("cache_hit") for _o, _u, r in self.results),
-                                               results=self.results, bent_images=dict(self.bent_images)))
+                                               outputs=outputs))
                 self.bent_images.clear()
         finally:  # also when cancelled: the scene goes back to its frame
             scene.frame_set(original)
@@ -342,7 +395,19 @@ class BakeJob:
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
                          for o in self._occluder_objects(obj) if o not in skip]
             settings = terminator_settings(req.settings, req.high_poly or objects)
-            gen = bake_steps(target, occluders, settings, high_to_low=high_to_low, vertex_target=vertex_target)
+            key = None
+            if frame is not None:
+                key = (label, bake_key(target, occluders, settings, high_to_low, vertex_target))
+                if key in self._frame_bakes:  # the geometry of an earlier frame: its files are copied
+                    earlier, stats, tiles = self._frame_bakes[key]
+                    self._copies[label] = earlier
+                    stub = BakeResult(None, None, None, {**stats, "cache_hit": True}, None, tiles)
+                    self.results.extend((o, uv_names[o.name], stub) for o in objects)
+                    yield start + share * (k + 1) / len(units), f"Reusing frame {earlier} for '{label}'{at}"
+                    continue
+            # A sequence bakes past the shared cache: it would hold up to its size in maps.
+            gen = bake_steps(target, occluders, settings, use_cache=frame is None, high_to_low=high_to_low,
+                             vertex_target=vertex_target)
             try:
                 while True:
                     try:
@@ -359,6 +424,8 @@ class BakeJob:
                                                            target, result)
             # A texture set's objects share one result (commit writes it once).
             self.results.extend((o, uv_names[o.name], result) for o in objects)
+            if key is not None:
+                self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
 
     def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target, result: BakeResult):
         """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
@@ -392,9 +459,10 @@ class BakeJob:
             pass
 
     # -- ending ----------------------------------------------------------------------------
-    def commit(self) -> list:
-        """Write files (atomically), then images and material nodes (or the colour
-        attributes). Returns the images."""
+    def commit(self, hold: bool = False) -> list:
+        """Write files (all or none), then images and material nodes (or the colour
+        attributes). Returns the images. hold: keep what the files replaced until release()
+        (cancel() puts it back), for a caller with more to write after."""
         if not self.finished:
             raise RuntimeError("commit() before the bake finished")
         req = self.request
@@ -402,16 +470,88 @@ class BakeJob:
             for obj, _uv, result in self.results:
                 color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
             return self.committed
-        if req.frames:
-            self._commit_frames()
+        if req.frames:  # each frame's files were written when it finished
             return self.committed
-        files = self.files  # (label, 'ao' | 'bent') -> the files written, one per UDIM tile
-        for obj, label, result in self.baked():
-            for kind, path, maps in (("ao", output_path_for(req, obj), result.ao),
-                                     ("bent", output_path_for(req, obj, req.bent_filepath),
-                                      self.bent_images.get(label))):
-                if path:
-                    files[label, kind] = self._write_maps(path, maps, result.tiles)
+        staged = self._stage_files()
+        try:
+            self.written += staged.commit()
+            self._store_images()
+        except BaseException:
+            staged.rollback()
+            self.written.clear()
+            raise
+        if hold:
+            self._staged = staged
+        else:
+            staged.release()
+        return self.committed
+
+    def written_note(self) -> str:
+        """A sequence stopped part-way: its finished frames in words ('frames 1 to 30 (30 frames,
+        30 files) are written'), '' when none."""
+        done = [e["frame"] for e in self.frame_results]
+        if not done:
+            return ""
+        count = sum(len(e["outputs"]) for e in self.frame_results)
+        files = f"{count} file{'s' if count != 1 else ''}"
+        if len(done) == 1:
+            return f"frame {done[0]} ({files}) is written"
+        return f"frames {done[0]} to {done[-1]} ({len(done)} frames, {files}) are written"
+
+    def release(self) -> None:
+        """After commit(hold=True): keep the files (drop the backups of those they replaced)."""
+        if self._staged is not None:
+            self._staged.release()
+            self._staged = None
+
+    def _stage_files(self, frame: int | None = None) -> StagedFiles:
+        """Every map of self.results (and self.bent_images) staged beside its file, one per
+        UDIM tile, after the collision check of the files as they turned out (tiles known);
+        self.files lists them by (label, kind)."""
+        req = self.request
+        tiles = {label: result.tiles for _obj, label, result in self.baked() if result.tiles}
+        if tiles:
+            check_output_files(planned_files(replace(req, frames=None if frame is None else [frame]), tiles),
+                               input_files(req))
+        staged = StagedFiles()
+        try:
+            for obj, label, result in self.baked():
+                for kind, filepath, _what, _channels in output_kinds(req):
+                    path = output_path_for(req, obj, filepath, frame)
+                    if not path:
+                        continue
+                    paths = [path] if result.tiles is None else [tile_path(path, t) for t in result.tiles]
+                    if label in self._copies:  # a repeated frame: the earlier frame's files, byte for byte
+                        earlier = output_path_for(req, obj, filepath, self._copies[label])
+                        sources = [earlier] if result.tiles is None else [tile_path(earlier, t) for t in result.tiles]
+                        for file_path, source in zip(paths, sources):
+                            staged.write_bytes(file_path, Path(source).read_bytes())
+                    else:
+                        maps = result.ao if kind == "ao" else self.bent_images.get(label)
+                        if maps is None:
+                            continue
+                        for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
+                            staged.write_image(file_path, tile_map)
+                    self.files.setdefault((label, kind), []).extend(paths)
+        except BaseException:
+            staged.discard()
+            raise
+        return staged
+
+    def _write_frame(self, frame: int) -> list[str]:
+        """Write the finished frame's files (all or none); returns them."""
+        staged = self._stage_files(frame)
+        self._copies.clear()
+        paths = staged.commit()
+        staged.release()
+        self.written += paths
+        return paths
+
+    def _store_images(self) -> None:
+        """Image datablocks (loaded from the files where tiled), the baked-map property and
+        material nodes of self.results."""
+        req = self.request
+        files = self.files
         stored = {}
         for obj, label, result in self.baked():
             name = req.image_name or f"{label}_AO"
@@ -428,21 +568,6 @@ class BakeJob:
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
-        return self.committed
-
-    def _commit_frames(self) -> None:
-        """A frame sequence's files: every frame's maps (each UDIM tile its own), in frame
-        order; no image datablocks (a sequence lives in files, as Blender's image sequences)."""
-        req = self.request
-        for entry in self.frame_results:
-            for obj, label, result in self.baked(entry["results"]):
-                for kind, filepath, maps in (("ao", req.filepath, result.ao),
-                                             ("bent", req.bent_filepath, entry["bent_images"].get(label))):
-                    path = output_path_for(req, obj, filepath, entry["frame"])
-                    if path:
-                        written = self._write_maps(path, maps, result.tiles)
-                        self.files.setdefault((label, kind), []).extend(written)
-                        entry.setdefault("outputs", []).extend(written)
 
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""
@@ -458,14 +583,6 @@ class BakeJob:
                 out.append((obj, self.label_of(obj), result))
         return out
 
-    def _write_maps(self, path: str, maps: np.ndarray, tiles: tuple[int, ...] | None) -> list[str]:
-        """Write a map to path, or each UDIM tile's to its own file (tile_path); returns them."""
-        paths = [path] if tiles is None else [tile_path(path, tile) for tile in tiles]
-        for file_path, tile_map in zip(paths, [maps] if tiles is None else maps):
-            write_ao_file(file_path, tile_map)
-            self.written.append(file_path)
-        return paths
-
     @staticmethod
     def _store_image(maps: np.ndarray, tiles: tuple[int, ...] | None, name: str, existing, tile_files):
         if tiles is None:
@@ -473,7 +590,12 @@ class BakeJob:
         return images.store_tiled_image(maps, tiles, name, existing, tile_files)
 
     def cancel(self) -> None:
-        """Undo the only early change: UV maps this job created."""
+        """Undo the only early change, UV maps this job created, and the files of a held
+        commit (a sequence's finished frames stay: they are complete, and listed in written)."""
+        if self._staged is not None:
+            self._staged.rollback()
+            self._staged = None
+            self.written.clear()
         for mesh, name in reversed(self.created_uv):
             layer = mesh.uv_layers.get(name)
             if layer is not None:

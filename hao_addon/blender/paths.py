@@ -2,22 +2,21 @@
 """Output paths as Blender users write them: '//' relative to the .blend file, '{object}'."""
 from __future__ import annotations
 
+import os
+
 import bpy
 
 from ..core.errors import BakeInputError
-
-OBJECT_TOKEN = "{object}"
-# A frame sequence's files: {frame} becomes the frame number, zero-padded like Blender's ####.
-FRAME_TOKEN = "{frame}"
-FRAME_DIGITS = 4
+from ..core.output_files import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN  # noqa: F401 - this module's names too
 
 
-def example_path(path: str) -> str:
+def example_path(path: str, frame: int = 0) -> str:
     """The path with every token filled by an example value ('{object}' -> 'object', <UDIM> ->
-    1001, '{frame}' -> 0000), for checking before a bake that such a file can be written."""
+    1001, '{frame}' -> the frame given, zero-padded: the sequence's first), for checking
+    before a bake that such a file can be written."""
     from ..core.bake.udim import FIRST_TILE, UDIM_TOKEN
     return (path.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, str(FIRST_TILE))
-            .replace(FRAME_TOKEN, "0" * FRAME_DIGITS))
+            .replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}"))
 
 
 def frame_pattern(path: str) -> str:
@@ -37,3 +36,9 @@ def absolute_path(path: str) -> str:
 def object_file_name(obj) -> str:
     """The object's name as it appears in file names (Blender's clean_name)."""
     return bpy.path.clean_name(obj.name)
+
+
+def input_file_name(path: str) -> str:
+    """An input file's name without extension as it appears in file names ('{input}'), cleaned
+    as object names are (object_file_name)."""
+    return bpy.path.clean_name(os.path.splitext(os.path.basename(path))[0])
