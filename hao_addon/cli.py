@@ -24,13 +24,15 @@ from .cli_io import (EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminat
 from .cli_options import add_setting_options, option_for, settings_from_args
 from .core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 from .core.errors import BakeInputError
+from .core.output_files import FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN, OutputCollision, check_output_files
 from .core.setting_spec import SettingError
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
-# A batch's file names in --out-dir, unless --out gives them ({input}: the input's stem).
-INPUT_TOKEN = "{input}"
+# A batch's file names in --out-dir, unless --out gives them ({input}: the input's name without
+# extension, cleaned for file names as object names are).
 BATCH_NAME = "{input}_ao.png"  # several meshes of an input: _{object} is added
 INPUT_FORMATS = (".obj", ".glb", ".gltf", ".blend")
+REPORT = "the report (--json)"  # its name in collision messages (a report that collides is not written)
 DEBUG_ENV = "HAO_DEBUG"  # set to 1: an internal error also prints its traceback and Blender's log
 
 
@@ -305,10 +307,10 @@ def parse_frames(spec: str) -> list[int]:
     step = int(match.group(3)) if match.group(3) is not None else 1
     if last < first or step < 1:
         raise CLIError(f"--frames '{spec}': the range must run forwards (A <= B) with a step of at least 1")
-    frames = list(range(first, last + 1, step))
-    if len(frames) > MAX_FRAMES:
+    frames = range(first, last + 1, step)
+    if len(frames) > MAX_FRAMES:  # counted before a list is made: 1-1000000000 is refused at once
         raise CLIError(f"--frames '{spec}' asks for {len(frames)} frames, more than {MAX_FRAMES}")
-    return frames
+    return list(frames)
 
 
 def pick_target(name: str, exclude: tuple = ()):
@@ -341,6 +343,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     settings = _validated(settings_from_args(args, BakeSettings), BakeSettings)
     source = check_input(Path(args.input), INPUT_FORMATS)
     frames = parse_frames(args.frames) if args.frames else None
+    first_frame = frames[0] if frames else 0
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
     to_colors = settings.target == "color-attribute"
@@ -349,7 +352,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                        "(.blend, .glb or .ply); --bent-normal-out and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
-        check_writable(example_path(args.bent_normal_out), settings.size, settings.size, 4,
+        check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
                        source=source)
     gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
@@ -357,8 +360,11 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     # Refused before a long load; checked again with the object's name once it is known.
     mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
     if not to_colors:
-        check_writable(example_path(args.out), settings.size, settings.size, 1, source=source)
+        check_writable(example_path(args.out, first_frame), settings.size, settings.size, 1, source=source)
     check_json_target(args.json)
+    reads, writes = _bake_files(args, source, mesh_out, gltf_out)
+    literal = [(path, what) for path, what in _image_outputs(args, to_colors) if not _has_token(path)]
+    check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
@@ -392,7 +398,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                           high_poly=high_poly, cage=cage,
                           bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
                           bent_space=args.bent_space, bent_convention=args.bent_convention,
-                          wire_material=gltf_out is not None)
+                          wire_material=gltf_out is not None,
+                          extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
+                          extra_outputs=writes + list(getattr(args, "batch_outputs", [])))
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     start_gpu()
     t0 = time.perf_counter()
@@ -401,23 +409,19 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
             for fraction, text in job.steps():
                 progress.update(text.split(":")[0], fraction if fraction > 0 else None)
         check_signals()  # never commit a run that was asked to stop
+        if gltf_out is not None and any(result.tiles for _o, _u, result in job.results):
+            raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs baked lie on several; bake without "
+                           "--gltf-out")
         with report.phase("write"):
-            job.commit()
+            job.commit(hold=True)  # all or nothing with the mesh files below: a failure puts back the maps
             if mesh_out is not None:
                 export_mesh_file(targets, mesh_out, colors=True)
             if gltf_out is not None:
-                try:
-                    if any(result.tiles for _o, _u, result in job.results):
-                        raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs baked lie on "
-                                       "several; bake without --gltf-out")
-                    export_glb(targets, gltf_out)
-                except BaseException:  # all or nothing: the maps just written go too
-                    for path in job.written:
-                        if os.path.exists(path):
-                            os.unlink(path)
-                    raise
+                export_glb(targets, gltf_out)
+            job.release()
     except BaseException:
         job.cancel()
+        _report_finished_frames(job, report)  # a sequence's finished frames stay, and are listed
         raise
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
     for obj, uv_name, result in job.results:
@@ -451,8 +455,48 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         report.outputs.append(str(gltf_out))
     if request.frames:
         report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"],
-                              outputs=e.get("outputs", [])) for e in job.frame_results]
+                              outputs=e["outputs"]) for e in job.frame_results]
     return lines
+
+
+def _report_finished_frames(job, report: Report) -> None:
+    """A failed or interrupted sequence: the frames it finished are on disk; the report lists
+    them (outputs, frames) and says so (kept, for the error line)."""
+    done = job.frame_results
+    if not done:
+        return
+    report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"], outputs=e["outputs"])
+                     for e in done]
+    report.outputs.extend(path for e in done for path in e["outputs"])
+    report.kept = job.written_note()
+
+
+def _bake_files(args, source: Path, mesh_out: Path | None, gltf_out: Path | None
+                ) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(what the bake reads, what it writes besides its maps), as (path, what) pairs for
+    core/output_files.py: the input and --high-poly files; the report, --gltf-out and a
+    colour bake's mesh file."""
+    reads = [(str(source), "the input file")]
+    reads += [(spec, f"the high-poly file '{spec}'") for spec in args.high_poly or ()
+              if Path(spec).suffix.lower() in INPUT_FORMATS and Path(spec).is_file()]
+    writes = [(args.json or "", REPORT)]
+    if mesh_out is not None:
+        writes.append((str(mesh_out), "the mesh file (--out)"))
+    if gltf_out is not None:
+        writes.append((str(gltf_out), "the glTF file (--gltf-out)"))
+    return reads, writes
+
+
+def _image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
+    """The image files named on the command line (patterns, tokens unfilled)."""
+    if to_colors:
+        return []
+    return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)")]
+
+
+def _has_token(path: str) -> bool:
+    from .core.bake.udim import UDIM_TOKEN
+    return any(token in path for token in (OBJECT_TOKEN, FRAME_TOKEN, UDIM_TOKEN))
 
 
 def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
@@ -471,6 +515,8 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     report.input = str(source)
     out = check_writable(args.out, size.width, size.height, 4, source=source)
     check_json_target(args.json)
+    check_output_files([(str(out), "the AO image (--out)"), (args.json or "", REPORT)],
+                       [(str(source), "the input file")])
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
@@ -529,9 +575,24 @@ def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
     if args.out_dir is None and len(args.input) == 1:
         if not args.out:
             raise CLIError("bake needs --out FILE (or --out-dir DIR)")
-        args.input, args.out = args.input[0], args.out.replace(INPUT_TOKEN, Path(args.input[0]).stem)
+        _fill_input_token(args, args.input[0])
+        args.input = args.input[0]
         return run_bake(args, report, progress)
     return run_batch(args, report, progress)
+
+
+def _fill_input_token(args, path: str) -> None:
+    """{input} in the output options becomes the input's cleaned name (input_file_name)."""
+    from .blender.paths import input_file_name
+    name = input_file_name(path)
+    for option in ("out", "bent_normal_out", "gltf_out"):
+        value = getattr(args, option)
+        if value:
+            setattr(args, option, value.replace(INPUT_TOKEN, name))
+
+
+def _to_colors(args) -> bool:
+    return getattr(args, "target", None) == "color-attribute"
 
 
 def run_batch(args, report: Report, progress: Progress) -> list[str]:
@@ -546,18 +607,35 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     template = args.out or BATCH_NAME
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
-    stems = [Path(path).stem for path in args.input]
-    if INPUT_TOKEN not in template and len(set(stems)) > 1:
+    if INPUT_TOKEN not in template and OBJECT_TOKEN not in template and len(args.input) > 1:
         raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
     from .gpu.shaders import cached_shader_count
-    lines = []
-    for path, stem in zip(args.input, stems):
+    subs = []
+    for path in args.input:
+        sub = argparse.Namespace(**vars(args))
+        sub.out = str(folder / template)
+        _fill_input_token(sub, path)
+        sub.input = path
+        subs.append(sub)
+    # Every input's files at once, before any bake: two inputs named alike in different folders
+    # ('a/x.obj', 'b/x.obj') would write one file. Names from {object} are checked per input,
+    # against what the inputs before it wrote (batch_outputs).
+    reads = [(os.path.abspath(path), f"input '{path}'") for path in args.input]
+    planned = [(args.json or "", REPORT)]
+    for sub in subs:
+        planned += [(p, f"{what} of input '{sub.input}'") for p, what in _image_outputs(sub, _to_colors(sub))
+                    + [(sub.gltf_out or "", "the glTF file (--gltf-out)")] if not _has_token(p)]
+    check_output_files(planned, reads)
+    lines, written = [], []
+    for sub in subs:
+        path = sub.input
         one = Report(command="bake", input=str(path), hao=report.hao, blender=report.blender)
         started, shaders = time.perf_counter(), cached_shader_count()
-        sub = argparse.Namespace(**vars(args))
-        sub.input, sub.out = path, str(folder / template.replace(INPUT_TOKEN, stem))
+        sub.batch_inputs = [entry for entry in reads if entry[1] != f"input '{path}'"]
+        sub.batch_outputs = list(written)
         try:
             lines += run_bake(sub, one, progress)
+            one.mark_done()
         except (KeyboardInterrupt, Terminated):
             raise
         except BaseException as exc:  # noqa: BLE001 - one input's failure is its line, the batch goes on
@@ -568,6 +646,7 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
         one.shaders_compiled = cached_shader_count() - shaders
         report.inputs.append(one.as_dict())
         report.outputs.extend(one.outputs)
+        written += [(out, f"an output of input '{path}'") for out in one.outputs]
         report.warnings.extend(f"{path}: {w}" for w in one.warnings)
     return lines
 
@@ -604,6 +683,8 @@ def main(argv: list[str] | None = None) -> int:
             if report.input_errors:
                 report.status = "partial"
                 report.error = f"{len(report.input_errors)} of {len(report.inputs)} inputs failed"
+            else:
+                report.mark_done()
         except SystemExit as exc:  # --help / --version
             return int(exc.code or 0)
         except BaseException as exc:  # noqa: BLE001 - every failure becomes one line and an exit code
@@ -611,8 +692,13 @@ def main(argv: list[str] | None = None) -> int:
             if report.inputs and code in EXIT_INTERRUPTED.values():  # a batch: the inputs before stay baked
                 message = message.replace("nothing was written", f"the {len(report.inputs)} inputs before it are "
                                                                  f"written, nothing of the one it stopped")
+            elif report.kept:  # a sequence: its finished frames stay (listed in the report)
+                message = (message.replace("nothing was written", f"{report.kept}, nothing of the frame it stopped")
+                           if code in EXIT_INTERRUPTED.values() else f"{message} ({report.kept})")
             report.status, report.error = ("interrupted" if code in EXIT_INTERRUPTED.values() else "error"), message
             io.err.write(f"hao: error: {message}\n")
+            if isinstance(exc, OutputCollision) and REPORT in exc.parties:
+                args.json = None  # its file is an input or another output: leave it alone
         report.exit_code = code
         report.timings["total"] = round(time.perf_counter() - started, 4)
         if args is not None and args.json:
@@ -620,12 +706,21 @@ def main(argv: list[str] | None = None) -> int:
         return code
 
 
+# Options whose value may start with '-' (argparse takes '-5-10' for an option otherwise).
+DASH_VALUE_OPTIONS = ("--frames",)
+
+
 def _parse(argv: list[str], io: ProcessOutput) -> argparse.Namespace:
     """parse_args with --help and --version written to the real stdout."""
     saved = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = io.out, io.err
+    joined = []
+    for arg in argv:  # '--frames -5-10' as '--frames=-5-10'
+        if joined and joined[-1] in DASH_VALUE_OPTIONS and re.match(r"-\d", arg):
+            arg = f"{joined.pop()}={arg}"
+        joined.append(arg)
     try:
-        return build_parser().parse_args(argv)
+        return build_parser().parse_args(joined)
     finally:
         sys.stdout, sys.stderr = saved
 

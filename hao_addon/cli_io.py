@@ -202,6 +202,10 @@ class Report:
     frames: list = field(default_factory=list)
     # A batch's input: the GPU shader variants it compiled (the first compiles, the rest reuse).
     shaders_compiled: int | None = None
+    # A run that failed or was stopped after some of its files were complete (a sequence's
+    # finished frames): what is on disk, in words, for the error line; not in the JSON
+    # (its outputs list the files).
+    kept: str = ""
 
     @contextlib.contextmanager
     def phase(self, name: str) -> Iterator[None]:
@@ -211,8 +215,14 @@ class Report:
         finally:
             self.timings[name] = round(self.timings.get(name, 0.0) + time.perf_counter() - t0, 4)
 
+    def mark_done(self) -> None:
+        """A run that finished: status 'warning' when something in it deserves a look (its
+        warnings say what), else 'ok'."""
+        self.status = "warning" if self.warnings else "ok"
+
     def as_dict(self) -> dict:
         out = asdict(self)
+        del out["kept"]
         if not self.inputs:  # a single bake's report keeps its shape
             del out["inputs"], out["input_errors"]
         if not self.frames:

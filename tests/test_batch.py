@@ -52,12 +52,13 @@ def test_batch_names_files_keeps_going_and_reports_each_input(inputs, tmp_path):
     assert done.stdout.count("hao: baked '") == 3
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["status"] == "partial" and report["exit_code"] == 1 and report["error"] == "1 of 4 inputs failed"
-    assert [i["status"] for i in report["inputs"]] == ["ok", "error", "ok", "ok"]
+    # Spot's UVs reach past 0..1: each baked input is done with a warning.
+    assert [i["status"] for i in report["inputs"]] == ["warning", "error", "warning", "warning"]
     assert report["inputs"][1]["exit_code"] == 2 and report["inputs"][1]["outputs"] == []
     assert report["outputs"] == [str(out / f"{n}_ao.png") for n in "abc"]
     # Per-input overhead: what an input costs beyond its bake phase, after the first (which
     # starts the GPU and compiles the shaders). Issue 13's target: 0.2 s.
-    ok = [i for i in report["inputs"] if i["status"] == "ok"]
+    ok = [i for i in report["inputs"] if i["status"] != "error"]
     overhead = [i["timings"]["total"] - i["timings"]["bake"] for i in ok]
     print(f"batch per-input overhead (s): {[round(x, 3) for x in overhead]}, bake phases: "
           f"{[i['timings']['bake'] for i in ok]}")

@@ -65,7 +65,8 @@ def test_object_token_and_json_report(dirs):
     assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == "", proc.stderr
     assert (out / "spot_ao.exr").is_file() and not list(out.glob("{*"))
     data = json.loads(report.read_text())
-    assert data["status"] == "ok" and data["exit_code"] == 0 and data["error"] is None
+    # Spot's UVs reach past 0 (a warning below): done, with something to look at.
+    assert data["status"] == "warning" and data["exit_code"] == 0 and data["error"] is None
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
