@@ -45,6 +45,10 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     finally:
         if own:
             renderer.free()
+    if not coverage.any():  # an empty picture is no AO: said as plainly as no mesh at all
+        raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects in the view of '{camera.name}': "
+                             f"every mesh lies outside its frame or its clip range ({camera.data.clip_start:g} "
+                             f"to {camera.data.clip_end:g})")
     rgba = np.empty((height, width, 4), np.float32)
     rgba[..., :3] = ao[..., None]
     rgba[..., 3] = coverage

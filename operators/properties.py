@@ -80,6 +80,8 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         if self.selected_to_active:
             cage = self.cage_object
             high_poly = [o for o in targets if o != active and o != cage]
+            if not high_poly and cage in targets:  # the cage alone besides the low-poly: say so, as the CLI does
+                high_poly = [cage]
             targets = [active] if active is not None else []
         settings = self.to_settings()
         to_image = settings.target == "image"  # a colour attribute ignores the image outputs

@@ -5,6 +5,8 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from ..core.errors import BakeInputError
+
 AO_ATTRIBUTE = "hao_ao"
 DOMAIN_NAMES = {"point": 'POINT', "corner": 'CORNER'}
 
@@ -12,17 +14,23 @@ DOMAIN_NAMES = {"point": 'POINT', "corner": 'CORNER'}
 def store_color_attribute(mesh: bpy.types.Mesh, values: np.ndarray, domain: str,
                           name: str = AO_ATTRIBUTE) -> bpy.types.Attribute:
     """Write accessibility values (n,) (one per vertex for 'point', per face corner for
-    'corner') as grey RGB, alpha 1, into the float colour attribute `name` (replaced where it
-    exists with another type or domain) and make it the active colour attribute, so the
+    'corner') as grey RGB, alpha 1, into the float colour attribute `name` (any attribute of
+    that name with another type or domain is replaced) and make it the active colour attribute, so the
     viewport's Attribute colour and the renderers' Color Attribute node show it. AO is data,
     written linear as Cycles writes its float colour attributes."""
     blender_domain = DOMAIN_NAMES[domain]
-    attribute = mesh.color_attributes.get(name)
+    # Every attribute of that name, not only colour ones: an INT 'hao_ao', or a colour one on
+    # the FACE domain, would otherwise keep the name and push ours to 'hao_ao.001'.
+    attribute = mesh.attributes.get(name)
     if attribute is not None and (attribute.domain != blender_domain or attribute.data_type != 'FLOAT_COLOR'):
-        mesh.color_attributes.remove(attribute)
+        mesh.attributes.remove(attribute)
         attribute = None
     if attribute is None:
         attribute = mesh.color_attributes.new(name, 'FLOAT_COLOR', blender_domain)
+    if attribute.name != name:  # a built-in or locked attribute held the name
+        mesh.attributes.remove(attribute)
+        raise BakeInputError(f"'{mesh.name}' keeps an attribute named '{name}' that cannot be replaced: "
+                             f"rename it and bake again")
     rgba = np.ones((len(values), 4), np.float32)
     rgba[:, :3] = np.asarray(values, np.float32)[:, None]
     attribute.data.foreach_set("color", rgba.ravel())

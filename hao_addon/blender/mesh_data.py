@@ -81,7 +81,8 @@ def corner_tangents(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_na
     the evaluated mesh's UV map, in evaluated_soup's corner order: what Blender's Normal Map
     node decodes tangent-space maps with. A mirroring transform flips the sign (Blender's
     shader multiplies the bitangent by the object's negative-scale sign). Raises
-    BakeInputError for faces of more than four corners (Mesh.calc_tangents refuses them)."""
+    n-gons are triangulated on a copy first (MikkTSpace takes triangles and quads; Blender's
+    own normal bake tessellates them too); quads and triangles keep their tangents."""
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
@@ -90,22 +91,90 @@ def corner_tangents(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_na
         mirrored = np.linalg.det(linear) < 0.0
         if mirrored:
             tri_loops = tri_loops[:, ::-1]
-        try:
-            mesh.calc_tangents(uvmap=uv_name)
-        except RuntimeError as err:
-            raise BakeInputError(f"'{obj.name}': tangent-space bent normals need faces of 3 or 4 corners "
-                                 f"(triangulate the n-gons, or bake them in object space): {err}") from None
-        tangent = np.empty(len(mesh.loops) * 3, np.float32)
-        mesh.loops.foreach_get("tangent", tangent)
-        sign = np.empty(len(mesh.loops), np.float32)
-        mesh.loops.foreach_get("bitangent_sign", sign)
-        mesh.free_tangents()
+        tangent, sign = _loop_tangents(mesh, uv_name)
         out = np.empty(tri_loops.shape + (4,))
-        out[..., :3] = tangent.reshape(-1, 3).astype(np.float64)[tri_loops] @ linear.T
+        out[..., :3] = tangent[tri_loops] @ linear.T
         out[..., 3] = sign[tri_loops] * (-1.0 if mirrored else 1.0)
         return out
     finally:
         obj_eval.to_mesh_clear()
+
+
+def _loop_tangents(mesh: bpy.types.Mesh, uv_name: str) -> tuple[np.ndarray, np.ndarray]:
+    """((L, 3) float64 object-space MikkTSpace tangents, (L,) bitangent signs) of every loop;
+    a mesh with n-gons through a copy whose n-gons are triangulated (n_gon_loop_tangents)."""
+    sizes = np.empty(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_total", sizes)
+    if len(sizes) and sizes.max() > 4:
+        return n_gon_loop_tangents(mesh, uv_name)
+    mesh.calc_tangents(uvmap=uv_name)
+    try:
+        return _read_tangents(mesh)
+    finally:
+        mesh.free_tangents()
+
+
+def _read_tangents(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    tangent = np.empty(len(mesh.loops) * 3, np.float32)
+    mesh.loops.foreach_get("tangent", tangent)
+    sign = np.empty(len(mesh.loops), np.float32)
+    mesh.loops.foreach_get("bitangent_sign", sign)
+    return tangent.reshape(-1, 3).astype(np.float64), sign
+
+
+# The face attribute that carries each polygon's index through the triangulated copy.
+SOURCE_FACE = "hao_source_face"
+
+
+def n_gon_loop_tangents(mesh: bpy.types.Mesh, uv_name: str) -> tuple[np.ndarray, np.ndarray]:
+    """_loop_tangents of a mesh with n-gons: a copy with only its n-gons triangulated (bmesh)
+    gets MikkTSpace tangents; each loop of the mesh takes those of a copy loop on the same
+    vertex of the same source face (MikkTSpace welds corners of equal position, normal and
+    UV, so inside a flat n-gon they agree). The mesh itself is not changed."""
+    import bmesh
+
+    bm = bmesh.new()
+    try:
+        bm.from_mesh(mesh)
+        layer = bm.faces.layers.int.new(SOURCE_FACE)
+        for face in bm.faces:
+            face[layer] = face.index
+        n_gons = [face for face in bm.faces if len(face.verts) > 4]
+        bmesh.ops.triangulate(bm, faces=n_gons, quad_method='BEAUTY', ngon_method='EAR_CLIP')
+        copy = bpy.data.meshes.new("hao_tangent_copy")
+        bm.to_mesh(copy)
+    finally:
+        bm.free()
+    try:
+        copy.calc_tangents(uvmap=uv_name)
+        tangent, sign = _read_tangents(copy)
+        source = np.empty(len(copy.polygons), np.int64)
+        copy.attributes[SOURCE_FACE].data.foreach_get("value", source)
+        copy_keys = _face_vertex_keys(copy, source)
+    finally:
+        bpy.data.meshes.remove(copy)
+    keys = _face_vertex_keys(mesh, np.arange(len(mesh.polygons)))
+    order = np.argsort(copy_keys, kind="stable")
+    match = order[np.searchsorted(copy_keys[order], keys)]
+    return tangent[match], sign[match]
+
+
+def _face_vertex_keys(mesh: bpy.types.Mesh, face_ids: np.ndarray) -> np.ndarray:
+    """(L,) int64 one key per loop: its face's id (face_ids, per polygon) and its vertex."""
+    starts = np.empty(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_start", starts)
+    totals = np.empty(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_total", totals)
+    loop_face = np.empty(len(mesh.loops), np.int64)
+    loop_face[np.repeat(starts, totals) + _ranks(totals)] = np.repeat(face_ids, totals)
+    verts = np.empty(len(mesh.loops), np.int64)
+    mesh.loops.foreach_get("vertex_index", verts)
+    return loop_face * (len(mesh.vertices) + 1) + verts
+
+
+def _ranks(totals: np.ndarray) -> np.ndarray:
+    """0, 1, ... within each run of the lengths totals: a polygon's loop offsets."""
+    return np.arange(int(totals.sum())) - np.repeat(np.cumsum(totals) - totals, totals)
 
 
 def extrusion_normals(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
