@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -66,6 +67,14 @@ mesh = bpy.data.meshes.new("Points")
 mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])
 bpy.context.scene.collection.objects.link(bpy.data.objects.new("Points", mesh))
 save("nofaces.blend")
+fresh(); cube(); camera(); bpy.context.scene.camera.data.clip_end = 0.5; save("farclip.blend")
+fresh(); cube(); bpy.context.active_object.name = "a b"; bpy.ops.mesh.primitive_cube_add(location=(3, 0, 0))
+bpy.context.active_object.name = "a_b"; save("twins.blend")
+fresh(); cube(); bpy.ops.mesh.primitive_cube_add(location=(3, 0, 0)); bare = bpy.context.active_object
+bare.name = "Bare"; bare.data.uv_layers.remove(bare.data.uv_layers[0]); save("nouv_pair.blend")
+fresh(); bpy.ops.mesh.primitive_plane_add(size=2); bpy.context.active_object.name = "Low"
+bpy.ops.mesh.primitive_cube_add(location=(0, 0, 3), size=1); bpy.context.active_object.name = "High"
+save("pair.blend")  # the high-poly far above the low-poly: no ray from it finds it
 fresh(); cube(); bpy.ops.export_scene.gltf(filepath=os.path.join(out, "scene.glb"))
 sys.stdout.flush()
 os._exit(0)  # bpy 4.2 segfaults at interpreter exit after a glTF export
@@ -96,11 +105,17 @@ def inputs(tmp_path_factory) -> Path:
         (folder / name).write_bytes(data)
     (folder / "folder.obj").mkdir()
     (folder / "dir.png").mkdir()
+    for sub in ("a", "b"):  # one name in two folders
+        (folder / sub).mkdir()
+        (folder / sub / "x.obj").write_bytes(files["degenerate.obj"])
+    for name in ("a b.obj", "a_b.obj"):  # two names that clean to one
+        (folder / name).write_bytes(files["degenerate.obj"])
     return folder
 
 
 def digest(folder: Path) -> dict[str, str]:
-    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir()) if p.is_file()}
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
 def unwritable_folder(tmp: Path) -> Path:
@@ -229,6 +244,104 @@ CASES = [
      "folder does not exist"),
     ("render-output-extension", [RENDER, "{in}/scene.blend", "--out", "{out}/a.tif"], 2,
      "unsupported output extension"),
+    ("render-everything-beyond-far-clip", [RENDER, "{in}/farclip.blend", "--out", "{out}/a.png", "--width", "32",
+                                           "--height", "24"], 2, "no visible mesh objects in the view of 'Camera'"),
+    ("render-report-is-input", [RENDER, "{in}/scene.blend", "--out", "{out}/a.png", "--json", "{in}/scene.blend"], 2,
+     "the report (--json) would overwrite the input file"),
+    ("render-report-is-output", [RENDER, "{in}/scene.blend", "--out", "{out}/a.png", "--json", "{out}/a.png"], 2,
+     "the AO image (--out) and the report (--json) would both be written to"),
+    # issue 28: one check of every file a run reads and writes (core/output_files.py)
+    ("report-is-input", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{in}/spot.obj"], 2,
+     "the report (--json) would overwrite the input file"),
+    ("report-is-output", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/a.png"], 2,
+     "the report (--json) and the AO map (--out) would both be written to"),
+    ("report-is-output-other-case", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/A.PNG"], 2,
+     "would both be written to"),
+    ("report-is-output-through-dots", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/../out/a.png"],
+     2, "would both be written to"),
+    ("report-is-bent-normals", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--bent-normal-out", "{out}/b.png",
+                                "--json", "{out}/b.png"], 2, "the bent normals (--bent-normal-out)"),
+    ("report-is-gltf", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--gltf-out", "{out}/a.glb", "--json",
+                        "{out}/a.glb"], 2, "the report (--json) and the glTF file (--gltf-out) would both be"),
+    ("report-is-object-map", [BAKE, "{in}/spot.obj", "--out", "{out}/{object}.png", "--json", "{out}/spot.png"], 2,
+     "the AO map of 'spot' and the report (--json) would both be written to"),
+    ("report-is-high-poly", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low", "--high-poly",
+                             "{in}/scene.glb", "--json", "{in}/scene.glb"], 2, "would overwrite the high-poly file"),
+    ("report-is-folder", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{in}/blend1"], 2,
+     "cannot write the report"),
+    ("report-is-mesh-out", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target", "color-attribute", "--json",
+                            "{out}/a.glb"], 2, "the mesh file (--out) would both be written to"),
+    ("bent-normals-are-the-map", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--bent-normal-out", "{out}/a.png"],
+     2, "the AO map (--out) and the bent normals (--bent-normal-out) would both be written to"),
+    ("bent-normals-extension", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--bent-normal-out", "{out}/b.jpg"],
+     2, "unsupported output extension"),
+    ("bent-normals-unknown-space", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--bent-normal-out",
+                                    "{out}/b.png", "--bent-space", "world"], 2, "invalid choice"),
+    ("gltf-out-is-input", [BAKE, "{in}/scene.glb", "--out", "{out}/a.png", "--gltf-out", "{in}/scene.glb"], 2,
+     "is the input file"),
+    ("gltf-out-extension", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--gltf-out", "{out}/a.gltf"], 2,
+     "--gltf-out must be a .glb"),
+    ("color-attribute-with-bent-normals", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target",
+                                           "color-attribute", "--bent-normal-out", "{out}/b.png"], 2,
+     "are image bakes"),
+    ("object-names-clean-alike", [BAKE, "{in}/twins.blend", "--all-meshes", "--out", "{out}/{object}.png"], 2,
+     "the AO map of 'a b' and the AO map of 'a_b' would both be written to"),
+    ("all-meshes-none", [BAKE, "{in}/nomesh.blend", "--all-meshes", "--out", "{out}/a.png"], 2,
+     "contains no mesh object"),
+    # batches
+    ("batch-same-name-two-folders", [BAKE, "{in}/a/x.obj", "{in}/b/x.obj", "--out-dir", "{out}"], 2,
+     "the AO map (--out) of input '{in}/a/x.obj' and the AO map (--out) of input '{in}/b/x.obj' would both"),
+    ("batch-names-clean-alike", [BAKE, "{in}/a b.obj", "{in}/a_b.obj", "--out-dir", "{out}"], 2,
+     "would both be written to '{out}/a_b_ao.png'"),
+    ("batch-without-input-token", [BAKE, "{in}/a/x.obj", "{in}/spot.obj", "--out-dir", "{out}", "--out", "m.png"],
+     2, "would write every input's map to the same file"),
+    ("batch-out-is-a-path", [BAKE, "{in}/spot.obj", "--out-dir", "{out}", "--out", "sub/{input}.png"], 2,
+     "is a file name in it, not a path"),
+    ("batch-out-dir-missing", [BAKE, "{in}/spot.obj", "--out-dir", "{out}/missing"], 2, "does not exist"),
+    ("batch-without-out-dir", [BAKE, "{in}/spot.obj", "{in}/a/x.obj", "--out", "{out}/a.png"], 2,
+     "give --out-dir DIR"),
+    ("batch-one-gltf-for-all", [BAKE, "{in}/spot.obj", "{in}/a/x.obj", "--out-dir", "{out}", "--gltf-out",
+                                "{out}/m.glb"], 2, "would both be written to"),
+    ("batch-report-is-an-input", [BAKE, "{in}/spot.obj", "{in}/a/x.obj", "--out-dir", "{out}", "--json",
+                                  "{in}/a/x.obj"], 2, "the report (--json) would overwrite input"),
+    # frame sequences
+    ("frames-a-billion", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "1-1000000000"], 2,
+     "asks for 1000000000 frames, more than 10000"),
+    ("frames-step-zero", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "1-5:0"], 2,
+     "a step of at least 1"),
+    ("frames-negative-backwards", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "-1--5"], 2,
+     "the range must run forwards"),
+    ("frames-names-the-first-frame", [BAKE, "{in}/spot.obj", "--out", "{out}/no/{frame}.png", "--frames", "5-6"], 2,
+     "no/0005.png': folder does not exist"),
+    ("frames-into-a-color-attribute", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target", "color-attribute",
+                                       "--frames", "1-2"], 2, "a colour attribute holds one frame"),
+    # Selected to Active
+    ("high-poly-all-rays-miss", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low", "--high-poly",
+                                 "High", "--size", "32", "--directions", "4"], 2, "found a high-poly surface"),
+    ("cage-extrusion-beyond-float32", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low",
+                                       "--high-poly", "High", "--cage-extrusion", "1e9", "--size", "32"], 2,
+     "a cage extrusion of 1e+09 is too far for 'Low'"),
+    ("cage-extrusion-negative", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low", "--high-poly",
+                                 "High", "--cage-extrusion", "-1"], 2, "(--cage-extrusion)"),
+    ("max-ray-distance-negative", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low",
+                                   "--high-poly", "High", "--max-ray-distance", "-1"], 2, "(--max-ray-distance)"),
+    ("high-poly-is-the-low-poly", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low",
+                                   "--high-poly", "Low"], 2, "cannot be both the high-poly and the low-poly"),
+    ("high-poly-unknown", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--high-poly", "Nope"], 2,
+     "--high-poly 'Nope' is neither a mesh file nor a mesh"),
+    ("high-poly-file-missing", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--high-poly", "{in}/none.obj"],
+     2, "--high-poly: input file not found"),
+    ("high-poly-onto-two-objects", [BAKE, "{in}/twins.blend", "--out", "{out}/{object}.png", "--object", "a b",
+                                    "--object", "a_b", "--high-poly", "{in}/pair.blend"], 2,
+     "bakes onto one low-poly"),
+    ("cage-unknown", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low", "--high-poly", "High",
+                      "--cage", "Nope"], 2, "--cage: no mesh object named 'Nope'"),
+    # texture sets and anti-aliasing
+    ("texture-set-object-without-uvs", [BAKE, "{in}/nouv_pair.blend", "--out", "{out}/a.png", "--texture-set",
+                                        "--object", "Box", "--object", "Bare"], 2,
+     "'Bare' has no UV map: a texture set bakes each object's own UVs"),
+    ("samples-per-texel-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--samples-per-texel", "3"], 2,
+     "invalid choice"),
 ]
 
 
@@ -247,10 +360,11 @@ def test_cli_bad_input(inputs, tmp_path, case):
     tmp.mkdir()
     subs = {"{in}": str(inputs), "{out}": str(out), "{locked}": str(unwritable_folder(tmp_path))}
     args = []
-    for arg in template:
+    for arg in template + [message]:
         for token, value in subs.items():
             arg = arg.replace(token, value)
         args.append(arg)
+    args, message = args[:-1], args[-1]
     before = digest(inputs)
     proc = run_cli(args, tmp)
     assert proc.returncode == code, (proc.returncode, proc.stderr)
@@ -262,7 +376,10 @@ def test_cli_bad_input(inputs, tmp_path, case):
 
 
 def test_enough_classes():
-    assert len(CASES) >= 40
+    """Issue 28: at least 100 classes across both entry points (the command line's here, the
+    operators' below)."""
+    operator_classes = len(BAKE_OPERATOR_CASES) + len(RENDER_OPERATOR_CASES)
+    assert len({c[0] for c in CASES}) == len(CASES) and len(CASES) + operator_classes >= 100
 
 
 # -- operators ------------------------------------------------------------------------------------
@@ -284,46 +401,84 @@ def two_cubes(*names):
     return objs
 
 
-@pytest.mark.parametrize("setup, message", [
-    ("colliding-names", "would both be saved as"),
-    ("relative-path-unsaved", "relative to the .blend file"),
-    ("unsupported-extension", "unsupported output extension"),
-    ("missing-uv-map", "no UV map named 'Nope'"),
-    ("nan-vertex", "NaN"),
-    ("name-too-long", "longer than the file system"),
-    ("nothing-selected", "Select one or more mesh objects"),
-])
-def test_bake_operator_bad_input(scene, tmp_path, setup, message):
+def _unsaved_relative_path(scene, tmp, a, b):
+    assert bpy.data.filepath == ""
+    small_settings(scene, filepath="//ao.png")
+
+
+def _nan_vertex(scene, tmp, a, b):
+    b.data.vertices[0].co = (float("nan"), 0.0, 0.0)
+    small_settings(scene)
+
+
+def _no_uv(obj):
+    obj.data.uv_layers.remove(obj.data.uv_layers[0])
+
+
+def _selected_to_active(scene, a, b, **kw):
+    bpy.context.view_layer.objects.active = a
+    small_settings(scene, selected_to_active=True, **kw)
+
+
+# (id, setup(scene, tmp_path, a, b) on two selected cubes 'a b' and 'a_b' 3 apart, message)
+BAKE_OPERATOR_CASES = [
+    ("colliding-names", lambda sc, tmp, a, b: small_settings(sc, filepath=str(tmp / "pair.png")),
+     "the AO map of 'a b' and the AO map of 'a_b' would both be written to"),
+    ("relative-path-unsaved", _unsaved_relative_path, "relative to the .blend file"),
+    ("unsupported-extension", lambda sc, tmp, a, b: small_settings(sc, filepath=str(tmp / "ao.bmp")),
+     "unsupported output extension"),
+    ("missing-uv-map", lambda sc, tmp, a, b: small_settings(sc, uv_mode='NAMED', uv_map="Nope"),
+     "no UV map named 'Nope'"),
+    ("nan-vertex", _nan_vertex, "NaN"),
+    ("name-too-long", lambda sc, tmp, a, b: small_settings(sc, filepath=str(tmp / ("x" * 300 + ".png"))),
+     "longer than the file system"),
+    ("nothing-selected", lambda sc, tmp, a, b: select_only(), "Select one or more mesh objects"),
+    # issue 28
+    ("bent-normals-are-the-map", lambda sc, tmp, a, b: small_settings(
+        sc, filepath=str(tmp / "{object}.png"), bent_normals=True, bent_filepath=str(tmp / "{object}.png")),
+     "the AO map of 'a b' and the bent normals of 'a b' would both be written to"),
+    ("frames-into-a-color-attribute", lambda sc, tmp, a, b: small_settings(sc, target="color-attribute",
+                                                                           frame_range=True),
+     "a colour attribute holds one frame"),
+    ("frames-name-the-first-frame", lambda sc, tmp, a, b: (setattr(sc, "frame_start", 5), small_settings(
+        sc, frame_range=True, filepath=str(tmp / "no" / "{frame}.png"))), "/no/0005_"),
+    ("texture-set-object-without-uvs", lambda sc, tmp, a, b: (_no_uv(b), small_settings(sc, texture_set=True)),
+     "'a_b' has no UV map: a texture set bakes each object's own UVs"),
+    ("cage-is-the-only-high-poly", lambda sc, tmp, a, b: _selected_to_active(sc, a, b, cage_object=b),
+     "'a_b' cannot be both the high-poly and the low-poly or cage"),
+    ("high-poly-all-rays-miss", lambda sc, tmp, a, b: (setattr(b, "location", (3, 3, 3)),  # off every axis ray
+                                                       _selected_to_active(sc, a, b)),
+     "texels of 'a b' found a high-poly surface"),
+    ("cage-extrusion-beyond-float32", lambda sc, tmp, a, b: _selected_to_active(sc, a, b, cage_extrusion=1e9),
+     "a cage extrusion of 1e+09 is too far for 'a b'"),
+]
+
+
+@pytest.mark.parametrize("case", BAKE_OPERATOR_CASES, ids=[c[0] for c in BAKE_OPERATOR_CASES])
+def test_bake_operator_bad_input(scene, tmp_path, case):
+    _name, setup, message = case
     a, b = two_cubes("a b", "a_b")
-    if setup == "colliding-names":
-        small_settings(scene, filepath=str(tmp_path / "pair.png"))
-    elif setup == "relative-path-unsaved":
-        assert bpy.data.filepath == ""
-        small_settings(scene, filepath="//ao.png")
-    elif setup == "unsupported-extension":
-        small_settings(scene, filepath=str(tmp_path / "ao.bmp"))
-    elif setup == "missing-uv-map":
-        small_settings(scene, uv_mode='NAMED', uv_map="Nope")
-    elif setup == "nan-vertex":
-        b.data.vertices[0].co = (float("nan"), 0.0, 0.0)
-        small_settings(scene)
-    elif setup == "name-too-long":
-        small_settings(scene, filepath=str(tmp_path / ("x" * 300 + ".png")))
-    elif setup == "nothing-selected":
-        select_only()
+    frame_start = scene.frame_start
+    setup(scene, tmp_path, a, b)
     before = scene_state()
-    with pytest.raises(RuntimeError, match=message):
-        bpy.ops.object.hao_bake_ao()
+    try:
+        with pytest.raises(RuntimeError, match=re.escape(message)):
+            bpy.ops.object.hao_bake_ao()
+    finally:
+        scene.frame_start = frame_start
     assert scene_state() == before
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("setup, message", [
+RENDER_OPERATOR_CASES = [
     ("resolution-beyond-limits", "texture limit"),
     ("relative-path-unsaved", "relative to the .blend file"),
     ("missing-folder", "folder does not exist"),
     ("no-mesh", "no visible mesh objects"),
-])
+]
+
+
+@pytest.mark.parametrize("setup, message", RENDER_OPERATOR_CASES)
 def test_render_operator_bad_input(scene, tmp_path, setup, message):
     bpy.ops.object.camera_add(location=(0, -6, 2), rotation=(1.3, 0, 0))
     scene.camera = bpy.context.active_object
