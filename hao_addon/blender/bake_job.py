@@ -172,6 +172,11 @@ def validate_request(request: BakeRequest) -> None:
     check_output_files(planned_files(request), input_files(request))
 
 
+def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
+    """The files of one map: path, or one per UDIM tile (tile_path)."""
+    return [path] if tiles is None else [tile_path(path, t) for t in tiles]
+
+
 def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
     """The image files a request writes per target: (kind, path pattern, what, channels)."""
     return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4))
@@ -196,8 +201,8 @@ def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple
                 path = output_path_for(request, obj, filepath, frame)
                 at = "" if frame is None else f" at frame {frame}"
                 numbers = (tiles or {}).get(label)
-                out += ([(path, f"{what} of '{label}'{at}")] if not numbers else
-                        [(tile_path(path, t), f"{what} of '{label}' tile {t}{at}") for t in numbers])
+                out += [(tile, f"{what} of '{label}'{f' tile {t}' if numbers else ''}{at}")
+                        for tile, t in zip(_tile_paths(path, numbers), numbers or [None])]
     return out + [tuple(entry) for entry in request.extra_outputs]
 
 
@@ -479,6 +484,7 @@ class BakeJob:
         except BaseException:
             staged.rollback()
             self.written.clear()
+            self.files.clear()
             raise
         if hold:
             self._staged = staged
@@ -520,11 +526,10 @@ class BakeJob:
                     path = output_path_for(req, obj, filepath, frame)
                     if not path:
                         continue
-                    paths = [path] if result.tiles is None else [tile_path(path, t) for t in result.tiles]
+                    paths = _tile_paths(path, result.tiles)
                     if label in self._copies:  # a repeated frame: the earlier frame's files, byte for byte
                         earlier = output_path_for(req, obj, filepath, self._copies[label])
-                        sources = [earlier] if result.tiles is None else [tile_path(earlier, t) for t in result.tiles]
-                        for file_path, source in zip(paths, sources):
+                        for file_path, source in zip(paths, _tile_paths(earlier, result.tiles)):
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
                         maps = result.ao if kind == "ao" else self.bent_images.get(label)
