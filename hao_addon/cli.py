@@ -19,11 +19,13 @@ from dataclasses import asdict, replace
 from pathlib import Path
 
 from . import __version__
-from .cli_io import (EXIT_INTERRUPTED, ProcessOutput, Progress, Report, Terminated, check_signals,
+from .cli_io import (EXIT_INTERRUPTED, REPORT, OpenJDProgress, ProcessOutput, Progress, Report, Terminated,
+                     check_signals,
                      deferred_signals, pending_signal, signals_as_exceptions)
 from .cli_options import add_setting_options, option_for, settings_from_args
 from .core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 from .core.errors import BakeInputError
+from .core.frame_ranges import parse_frames
 from .core.output_files import FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN, OutputCollision, check_output_files
 from .core.setting_spec import SettingError
 
@@ -32,7 +34,6 @@ EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
 # extension, cleaned for file names as object names are).
 BATCH_NAME = "{input}_ao.png"  # several meshes of an input: _{object} is added
 INPUT_FORMATS = (".obj", ".glb", ".gltf", ".blend")
-REPORT = "the report (--json)"  # its name in collision messages (a report that collides is not written)
 DEBUG_ENV = "HAO_DEBUG"  # set to 1: an internal error also prints its traceback and Blender's log
 
 
@@ -48,14 +49,46 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .core.bake.settings import BakeSettings
     from .core.hao.view_settings import RenderSize, ViewAOSettings
 
     parser = _Parser(prog="hao", description="GPU ambient occlusion for Blender scenes and meshes.")
     parser.add_argument("--version", action="version", version=f"hao {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     b = sub.add_parser("bake", help="bake per-texel AO of a mesh into an image file")
-    b.add_argument("input", nargs="+", help=".obj, .glb/.gltf or .blend file; several make a batch (--out-dir)")
+    add_bake_arguments(b)
+    b.add_argument("--manifest", default=None, metavar="FILE",
+                   help="a farm task: bake chunk --chunk of this job manifest (written by 'farm'), its inputs "
+                        "relative to --input-root (default: the manifest's root), into --out-dir")
+    b.add_argument("--chunk", type=int, default=0, help="with --manifest: the chunk to bake (0 is the first)")
+    b.add_argument("--input-root", default=None, metavar="DIR", help="with --manifest: the folder of its inputs")
+    b.add_argument("--progress", choices=("terminal", "openjd"), default="terminal",
+                   help="terminal: a progress line on a terminal; openjd: 'openjd_progress: P' lines on stdout "
+                        "(Open Job Description's form, for farm tasks)")
+    _add_run_options(b)
+
+    from .cli_farm import add_farm_parsers
+    add_farm_parsers(sub, add_bake_arguments, _add_run_options)
+
+    r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
+    r.add_argument("input", help=".blend file (or .obj/.glb with a camera in it)")
+    r.add_argument("--out", required=True, help="output .png (16-bit RGBA) or .exr (32-bit float RGBA)")
+    r.add_argument("--camera", default="", help="camera object (default: the scene camera)")
+    add_setting_options(r, RenderSize)
+    add_setting_options(r, ViewAOSettings)
+    r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
+    r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
+    r.add_argument("--spheres", type=int, default=0,
+                   help="sync K sphere proxies on every mesh with an Armature modifier first (0: use those stored)")
+    _add_run_options(r)
+    return parser
+
+
+def add_bake_arguments(b: argparse.ArgumentParser) -> None:
+    """What a bake takes (bake, and the farm commands that write bake jobs): inputs, outputs,
+    frames and every bake setting."""
+    from .core.bake.settings import BakeSettings
+
+    b.add_argument("input", nargs="*", help=".obj, .glb/.gltf or .blend file; several make a batch (--out-dir)")
     b.add_argument("--out", default=None,
                    help="output .png (16-bit) or .exr (32-bit float); {object} becomes the baked object's name, "
                         "{input} the input file's name without extension. With --target color-attribute: the "
@@ -64,10 +97,15 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--out-dir", default=None, metavar="DIR",
                    help="a batch: every input is baked (a failed one does not stop the others; exit 1 if any "
                         "failed), its files written into DIR as --out names them")
-    b.add_argument("--frames", default=None, metavar="A-B[:STEP]",
-                   help="bake frames A to B (every STEP-th) of the scene's animation, one map per frame: "
+    b.add_argument("--frames", default=None, metavar="A-B[:STEP][,...]",
+                   help="bake frames A to B (every STEP-th; several ranges joined by commas, Open Job "
+                        "Description's syntax: 1-3,5,7-20:2) of the scene's animation, one map per frame: "
                         "{frame} in --out becomes the frame, zero-padded to 4 digits (else _{frame} is added); a "
                         "frame whose evaluated meshes equal an earlier one's reuses its bake")
+    b.add_argument("--skip-existing", action="store_true",
+                   help="bake only what is missing: an output whose file exists and was made from the same input "
+                        "files and settings (a key in its metadata) is kept, as is each such frame of --frames; "
+                        "other files are baked again (a re-queued farm task redoes only what is missing)")
     b.add_argument("--all-meshes", action="store_true",
                    help="bake every mesh of each input (each into its own file), not only the largest")
     add_setting_options(b, BakeSettings)
@@ -97,20 +135,6 @@ def build_parser() -> argparse.ArgumentParser:
     for option, choices in (("--bent-space", SPACE_CHOICES), ("--bent-convention", CONVENTION_CHOICES)):
         b.add_argument(option, choices=[c.value for c in choices], default=choices[0].value,
                        help="; ".join(f"{c.value}: {c.description}" for c in choices) + f" (default {choices[0].value})")
-    _add_run_options(b)
-
-    r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
-    r.add_argument("input", help=".blend file (or .obj/.glb with a camera in it)")
-    r.add_argument("--out", required=True, help="output .png (16-bit RGBA) or .exr (32-bit float RGBA)")
-    r.add_argument("--camera", default="", help="camera object (default: the scene camera)")
-    add_setting_options(r, RenderSize)
-    add_setting_options(r, ViewAOSettings)
-    r.add_argument("--frame", type=int, default=None, help="scene frame to render (default: current)")
-    r.add_argument("--skip-baked", action="store_true", help="no HAO on objects that carry a baked AO map")
-    r.add_argument("--spheres", type=int, default=0,
-                   help="sync K sphere proxies on every mesh with an Armature modifier first (0: use those stored)")
-    _add_run_options(r)
-    return parser
 
 
 def _add_run_options(p: argparse.ArgumentParser) -> None:
@@ -293,26 +317,6 @@ def export_glb(objects: list, path: Path) -> None:
     export_mesh_file(objects, path)
 
 
-# At most this many frames in one --frames range (a typo such as 1-100000 is refused).
-MAX_FRAMES = 10_000
-
-
-def parse_frames(spec: str) -> list[int]:
-    """The frames of 'A-B[:STEP]' (or one frame 'A'), A <= B, STEP >= 1."""
-    match = re.fullmatch(r"\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*(?::\s*(\d+))?\s*", spec)
-    if match is None:
-        raise CLIError(f"--frames '{spec}': expected A-B or A-B:STEP (for example 1-48 or 1-48:2)")
-    first = int(match.group(1))
-    last = int(match.group(2)) if match.group(2) is not None else first
-    step = int(match.group(3)) if match.group(3) is not None else 1
-    if last < first or step < 1:
-        raise CLIError(f"--frames '{spec}': the range must run forwards (A <= B) with a step of at least 1")
-    frames = range(first, last + 1, step)
-    if len(frames) > MAX_FRAMES:  # counted before a list is made: 1-1000000000 is refused at once
-        raise CLIError(f"--frames '{spec}' asks for {len(frames)} frames, more than {MAX_FRAMES}")
-    return list(frames)
-
-
 def pick_target(name: str, exclude: tuple = ()):
     """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
     import bpy
@@ -334,7 +338,9 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     """Bake; returns the summary lines to print."""
     import bpy
 
-    from .blender.bake_job import BakeJob, BakeRequest, output_path_for
+    from .blender.bake_job import BakeJob, BakeRequest, output_path_for, validate_request
+    from .cli_skip import run_key, skip_finished
+    from .core.imageio import BAKE_KEY
     from .blender.color_attributes import AO_ATTRIBUTE
     from .blender.paths import example_path, frame_pattern
     from .core.imageio import check_writable
@@ -365,6 +371,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     reads, writes = _bake_files(args, source, mesh_out, gltf_out)
     literal = [(path, what) for path, what in _image_outputs(args, to_colors) if not _has_token(path)]
     check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
+    key = run_key(args, [Path(path) for path, _what in reads])
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
@@ -400,7 +407,14 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                           bent_space=args.bent_space, bent_convention=args.bent_convention,
                           wire_material=gltf_out is not None,
                           extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
-                          extra_outputs=writes + list(getattr(args, "batch_outputs", [])))
+                          extra_outputs=writes, claimed=list(getattr(args, "batch_outputs", [])),
+                          file_text={BAKE_KEY: key})
+    skip_lines = []
+    if args.skip_existing:
+        validate_request(request)  # a run that would be refused is refused, finished or not
+        request, skip_lines = skip_finished(request, key, report)
+        if request is None:
+            return skip_lines
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     start_gpu()
     t0 = time.perf_counter()
@@ -421,7 +435,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
             job.release()
     except BaseException:
         job.cancel()
-        _report_finished_frames(job, report)  # a sequence's finished frames stay, and are listed
+        _report_frames(job, report)  # a sequence's finished frames stay, and are listed
+        report.kept = job.written_note()
         raise
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
     for obj, uv_name, result in job.results:
@@ -433,13 +448,13 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                                    **({"texture_set": True} if args.texture_set else {}),
                                    **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
                                    **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
-    lines = []
+    lines = skip_lines
     for obj, label, result in job.baked():
         st = result.stats
         tile_files = job.files.get((label, "ao"), [])
-        several = len(tile_files) > 1 or request.frames  # UDIM tiles or frames: every file
-        report.outputs.extend(tile_files if several else [output_path_for(request, obj)])
-        report.outputs.extend(job.files.get((label, "bent"), []))
+        if not request.frames:  # a sequence's files are listed frame by frame (_report_frames)
+            report.outputs.extend(tile_files if len(tile_files) > 1 else [output_path_for(request, obj)])
+            report.outputs.extend(job.files.get((label, "bent"), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
@@ -454,21 +469,18 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     if gltf_out is not None:
         report.outputs.append(str(gltf_out))
     if request.frames:
-        report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"],
-                              outputs=e["outputs"]) for e in job.frame_results]
+        _report_frames(job, report)
     return lines
 
 
-def _report_finished_frames(job, report: Report) -> None:
-    """A failed or interrupted sequence: the frames it finished are on disk; the report lists
-    them (outputs, frames) and says so (kept, for the error line)."""
-    done = job.frame_results
-    if not done:
-        return
-    report.frames = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"], outputs=e["outputs"])
-                     for e in done]
-    report.outputs.extend(path for e in done for path in e["outputs"])
-    report.kept = job.written_note()
+def _report_frames(job, report: Report) -> None:
+    """A sequence's frames in the report, in frame order: those baked (all, or the finished
+    ones of a failed or interrupted run: they stay on disk) beside those --skip-existing
+    found current; outputs lists every frame's files."""
+    baked = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"], outputs=e["outputs"])
+             for e in job.frame_results]
+    report.frames = sorted(report.frames + baked, key=lambda entry: entry["frame"])
+    report.outputs.extend(path for entry in report.frames for path in entry["outputs"])
 
 
 def _bake_files(args, source: Path, mesh_out: Path | None, gltf_out: Path | None
@@ -571,7 +583,15 @@ def _validated(settings, settings_cls):
 
 
 def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
-    """`bake`: one input with --out, or a batch (--out-dir, or several inputs)."""
+    """`bake`: one input with --out, or a batch (--out-dir, or several inputs), or a farm
+    task's chunk of a manifest (--manifest, --chunk)."""
+    if args.manifest:
+        from .cli_farm import take_manifest_chunk
+        take_manifest_chunk(args)
+    if not args.input:
+        raise CLIError("bake needs an INPUT file (or --manifest FILE)")
+    if args.frames:
+        parse_frames(args.frames)  # refused before any input is loaded
     if args.out_dir is None and len(args.input) == 1:
         if not args.out:
             raise CLIError("bake needs --out FILE (or --out-dir DIR)")
@@ -627,8 +647,9 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
                     + [(sub.gltf_out or "", "the glTF file (--gltf-out)")] if not _has_token(p)]
     check_output_files(planned, reads)
     lines, written = [], []
-    for sub in subs:
+    for index, sub in enumerate(subs):
         path = sub.input
+        progress.share(index, len(subs))
         one = Report(command="bake", input=str(path), hao=report.hao, blender=report.blender)
         started, shaders = time.perf_counter(), cached_shader_count()
         sub.batch_inputs = [entry for entry in reads if entry[1] != f"input '{path}'"]
@@ -651,7 +672,17 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     return lines
 
 
-COMMANDS = {"bake": run_bake_command, "render-ao": run_render_ao}
+def run_farm_command(args, report: Report, progress: Progress) -> list[str]:
+    from .cli_farm import run_farm
+    return run_farm(args, report, progress)
+
+
+COMMANDS = {"bake": run_bake_command, "render-ao": run_render_ao, "farm": run_farm_command}
+
+
+def _needs_blender(args) -> bool:
+    """Whether the command loads Blender (writing a farm job does not: 10,000 inputs in seconds)."""
+    return args.command != "farm" or args.farm_command == "verify"
 
 
 # -- entry point ------------------------------------------------------------------------------------
@@ -664,10 +695,14 @@ def main(argv: list[str] | None = None) -> int:
         args = None
         try:
             args = _parse(argv, io)
-            with deferred_signals():
-                import bpy
-            report.blender = bpy.app.version_string
-            progress = Progress(io.err, enabled=io.err_is_terminal and not args.quiet)
+            if _needs_blender(args):
+                with deferred_signals():
+                    import bpy
+                report.blender = bpy.app.version_string
+            if getattr(args, "progress", "") == "openjd":  # a farm task: its progress for the farm
+                progress = OpenJDProgress(io.out)
+            else:
+                progress = Progress(io.err, enabled=io.err_is_terminal and not args.quiet)
             try:
                 lines = COMMANDS[args.command](args, report, progress)
             finally:

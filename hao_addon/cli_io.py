@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Iterator, TextIO
 
 EXIT_INTERRUPTED = {signal.SIGINT: 130, signal.SIGTERM: 143}
+REPORT = "the report (--json)"  # its name in collision messages (a report that collides is not written)
 
 
 class Terminated(BaseException):
@@ -171,11 +172,45 @@ class Progress:
         self.stream.write("\r\033[K" + text)
         self.stream.flush()
 
+    def share(self, index: int, count: int) -> None:
+        """A batch: input index of count starts (the terminal line shows each input's own)."""
+
     def finish(self) -> None:
         if self._shown:
             self.stream.write("\r\033[K")
             self.stream.flush()
             self._shown = False
+
+
+class OpenJDProgress:
+    """A farm task's progress as Open Job Description reads it from stdout: a line
+    'openjd_progress: P' (P in percent of the whole task: a batch's inputs share it) when it
+    has grown by a percent or more, and at the end."""
+
+    STEP = 1.0
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self._offset, self._scale = 0.0, 1.0
+        self._last = -self.STEP
+
+    def share(self, index: int, count: int) -> None:
+        self._offset, self._scale = index / count, 1.0 / count
+        self._report(100.0 * self._offset)
+
+    def update(self, phase: str, fraction: float | None = None) -> None:
+        check_signals()
+        if fraction is not None:
+            self._report(100.0 * (self._offset + self._scale * min(max(fraction, 0.0), 1.0)))
+
+    def finish(self) -> None:
+        """Nothing to clear (a finished task has said 100 with its last input)."""
+
+    def _report(self, percent: float) -> None:
+        if percent - self._last >= self.STEP or (percent >= 100.0 > self._last):
+            self._last = percent
+            self.stream.write(f"openjd_progress: {percent:.1f}\n")
+            self.stream.flush()
 
 
 @dataclass
@@ -198,8 +233,11 @@ class Report:
     # A batch: one report per input (as_dict), and the failed ones' lines.
     inputs: list = field(default_factory=list)
     input_errors: list = field(default_factory=list)
-    # A frame sequence: per frame {frame, seconds, reused, outputs}.
+    # A frame sequence: per frame {frame, seconds, reused, outputs} (skipped: true for a frame
+    # --skip-existing found current).
     frames: list = field(default_factory=list)
+    # --skip-existing: the files found current and kept (listed in outputs too).
+    skipped: list = field(default_factory=list)
     # A batch's input: the GPU shader variants it compiled (the first compiles, the rest reuse).
     shaders_compiled: int | None = None
     # A run that failed or was stopped after some of its files were complete (a sequence's
@@ -227,6 +265,8 @@ class Report:
             del out["inputs"], out["input_errors"]
         if not self.frames:
             del out["frames"]
+        if not self.skipped:
+            del out["skipped"]
         if self.shaders_compiled is None:
             del out["shaders_compiled"]
         return out

@@ -9,6 +9,7 @@ report, and the scene unchanged (no image, UV map, attribute or material added).
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import re
 import shutil
@@ -110,6 +111,9 @@ def inputs(tmp_path_factory) -> Path:
         (folder / sub / "x.obj").write_bytes(files["degenerate.obj"])
     for name in ("a b.obj", "a_b.obj"):  # two names that clean to one
         (folder / name).write_bytes(files["degenerate.obj"])
+    (folder / "manifest.json").write_text(json.dumps(  # a farm job's, of one input
+        {"version": 1, "root": str(folder), "entries": ["spot.obj"], "chunk_size": 1, "out": "{input}_ao.png",
+         "frames": ""}))
     return folder
 
 
@@ -131,6 +135,7 @@ def unwritable_folder(tmp: Path) -> Path:
 # (id, arguments ({in}: the inputs folder, {out}: a fresh output folder), exit code, message)
 BAKE = "bake"
 RENDER = "render-ao"
+FARM = "farm"
 CASES = [
     # input files
     ("missing-input", [BAKE, "{in}/missing.obj", "--out", "{out}/a.png"], 2, "input file not found"),
@@ -342,6 +347,37 @@ CASES = [
      "'Bare' has no UV map: a texture set bakes each object's own UVs"),
     ("samples-per-texel-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--samples-per-texel", "3"], 2,
      "invalid choice"),
+    ("bake-without-input", [BAKE, "--out", "{out}/a.png"], 2, "bake needs an INPUT file (or --manifest FILE)"),
+    # farm jobs (issue 29)
+    ("farm-without-inputs", [FARM, "openjd", "--out-dir", "{out}", "--bundle", "{out}/job"], 2,
+     "farm openjd needs the INPUT files of the job"),
+    ("farm-without-out-dir", [FARM, "flamenco", "{in}/spot.obj", "--bundle", "{out}/job"], 2,
+     "farm flamenco needs --out-dir DIR"),
+    ("farm-without-bundle", [FARM, "opencue", "{in}/spot.obj", "--out-dir", "{out}"], 2,
+     "the following arguments are required: --bundle"),
+    ("farm-missing-input", [FARM, "openjd", "{in}/none.obj", "--out-dir", "{out}", "--bundle", "{out}/job"], 2,
+     "input file not found"),
+    ("farm-chunk-size-zero", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                              "--chunk-size", "0"], 2, "--chunk-size must be at least 1"),
+    ("farm-frames-of-two-inputs", [FARM, "openjd", "{in}/spot.obj", "{in}/scene.glb", "--out-dir", "{out}",
+                                   "--bundle", "{out}/job", "--frames", "1-9"], 2, "give one input"),
+    ("farm-frames-a-billion", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                               "--frames", "1-1000000000"], 2, "more than 10000"),
+    ("farm-unknown-runner", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                             "--runner", "maya"], 2, "invalid choice"),
+    ("farm-out-is-a-path", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                            "--out", "sub/{input}.png"], 2, "is a file name in it, not a path"),
+    ("farm-unknown-format", [FARM, "slurm", "{in}/spot.obj"], 2, "invalid choice"),
+    ("task-manifest-and-inputs", [BAKE, "{in}/spot.obj", "--manifest", "{in}/manifest.json", "--out-dir", "{out}"],
+     2, "--manifest names the inputs: give no INPUT besides it"),
+    ("task-chunk-beyond-the-job", [BAKE, "--manifest", "{in}/manifest.json", "--chunk", "5", "--out-dir", "{out}"],
+     2, "chunk 5 is not in this job: it has chunks 0 to 0"),
+    ("task-manifest-not-a-manifest", [BAKE, "--manifest", "{in}/spot.obj", "--out-dir", "{out}"], 2,
+     "cannot read the manifest"),
+    ("task-manifest-without-out-dir", [BAKE, "--manifest", "{in}/manifest.json"], 2,
+     "--manifest needs --out-dir DIR"),
+    ("verify-outputs-missing", [FARM, "verify", "--manifest", "{in}/manifest.json", "--out-dir", "{out}"], 1,
+     "1 of 1 expected outputs are missing or empty: spot_ao.png"),
 ]
 
 

@@ -11,6 +11,7 @@ sequence keeps its finished frames, listed in ``written``).
 """
 from __future__ import annotations
 
+import glob
 import os
 import time
 from dataclasses import dataclass, field, replace
@@ -22,7 +23,7 @@ import numpy as np
 
 from .. import compat
 from ..bake import BakeResult, bake_key, bake_steps
-from ..core.imageio import StagedFiles, check_writable
+from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
 from ..core.output_files import check_output_files
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
@@ -83,9 +84,14 @@ class BakeRequest:
     frames: list | None = None
     # What else the caller reads and writes, as (path, what) pairs, so that one check
     # (core/output_files.py) sees every file of the run: the CLI's --json report, --gltf-out,
-    # a colour bake's mesh file, high-poly files, a batch's other inputs and earlier outputs.
+    # a colour bake's mesh file, high-poly files, a batch's other inputs.
     extra_inputs: list = field(default_factory=list)
     extra_outputs: list = field(default_factory=list)
+    # Files others write (a batch's earlier inputs' outputs): this run must not write them.
+    claimed: list = field(default_factory=list)
+    # Text entries every image file of the run carries (core/imageio.py's BAKE_KEY: what made
+    # it, for --skip-existing).
+    file_text: dict = field(default_factory=dict)
 
     @property
     def to_color_attribute(self) -> bool:
@@ -169,7 +175,7 @@ def validate_request(request: BakeRequest) -> None:
             if path:
                 check_writable(example_path(path, (request.frames or [0])[0]), size, size, channels,
                                source=request.source_path or None)
-    check_output_files(planned_files(request), input_files(request))
+    check_output_files(planned_files(request) + list(request.claimed), input_files(request))
 
 
 def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
@@ -204,6 +210,34 @@ def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple
                 out += [(tile, f"{what} of '{label}'{f' tile {t}' if numbers else ''}{at}")
                         for tile, t in zip(_tile_paths(path, numbers), numbers or [None])]
     return out + [tuple(entry) for entry in request.extra_outputs]
+
+
+def finished_files(request: BakeRequest, key: str, frame: int | None = None) -> list[str] | None:
+    """The files of the request (of one frame of a sequence) when every one exists and is
+    current: an image carries key as its BAKE_KEY (a map on UDIM tiles: every tile file
+    that exists does, and one at least), another file (glTF, mesh) is not empty. None when
+    anything is missing or was made otherwise: the bake must run."""
+    one = replace(request, frames=None if frame is None else [frame])
+    done = []
+    for path, _what in planned_files(one):
+        if not path or path == "-":
+            continue
+        if os.path.splitext(path)[1].lower() not in FORMATS:
+            if not (os.path.isfile(path) and os.path.getsize(path) > 0):
+                return None
+            done.append(path)
+            continue
+        files = [path] if os.path.isfile(path) else sorted(glob.glob(_tile_glob(path)))
+        if not files or any(read_text(f, BAKE_KEY) != key for f in files):
+            return None
+        done += files
+    return done
+
+
+def _tile_glob(path: str) -> str:
+    """A pattern of the UDIM tile files of path (tile_path with any four-digit number)."""
+    marker = 987654321  # a number no path holds, where the tile's goes
+    return glob.escape(tile_path(path, marker)).replace(str(marker), "[0-9]" * 4)
 
 
 def input_files(request: BakeRequest) -> list[tuple[str, str]]:
@@ -517,8 +551,8 @@ class BakeJob:
         req = self.request
         tiles = {label: result.tiles for _obj, label, result in self.baked() if result.tiles}
         if tiles:
-            check_output_files(planned_files(replace(req, frames=None if frame is None else [frame]), tiles),
-                               input_files(req))
+            check_output_files(planned_files(replace(req, frames=None if frame is None else [frame]), tiles)
+                               + list(req.claimed), input_files(req))
         staged = StagedFiles()
         try:
             for obj, label, result in self.baked():
@@ -536,7 +570,7 @@ class BakeJob:
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
-                            staged.write_image(file_path, tile_map)
+                            staged.write_image(file_path, tile_map, req.file_text)
                     self.files.setdefault((label, kind), []).extend(paths)
         except BaseException:
             staged.discard()

@@ -141,9 +141,9 @@ class StagedFiles:
             fh.write(data)
         os.chmod(tmp, 0o666 & ~_umask())
 
-    def write_image(self, path: str | Path, image: np.ndarray) -> None:
+    def write_image(self, path: str | Path, image: np.ndarray, text: dict[str, str] | None = None) -> None:
         """(H, W) or (H, W, 4) to .png (16-bit) or .exr (32-bit float), as write_ao_file."""
-        self.write_bytes(path, encode_image(path, image))
+        self.write_bytes(path, encode_image(path, image, text))
 
     def commit(self) -> list[str]:
         """Rename every staged file into place; returns their paths. On failure, rolls back."""
@@ -192,8 +192,15 @@ def _umask() -> int:
     return umask
 
 
-def png16_bytes(image: np.ndarray) -> bytes:
-    """16-bit PNG of image (H, W) gray or (H, W, 4) RGBA in [0, 1], row 0 = bottom."""
+# The text entry a bake's files carry: a digest of what made them (the input files, the
+# settings, the version; cli_farm.py), so that --skip-existing can tell a finished output
+# from one of other settings. PNG: a tEXt chunk; EXR: a string attribute.
+BAKE_KEY = "hao_bake_key"
+
+
+def png16_bytes(image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
+    """16-bit PNG of image (H, W) gray or (H, W, 4) RGBA in [0, 1], row 0 = bottom; text:
+    Latin-1 tEXt entries (keyword -> value), before the image data."""
     img = np.clip(np.nan_to_num(np.asarray(image, np.float64)), 0.0, 1.0)
     h, w = img.shape[:2]
     channels = 1 if img.ndim == 2 else img.shape[2]
@@ -208,10 +215,13 @@ def png16_bytes(image: np.ndarray) -> bytes:
 
     colour_type = 0 if channels == 1 else 6  # gray or RGBA
     ihdr = struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0)
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)) + chunk(b"IEND", b"")
+    texts = b"".join(chunk(b"tEXt", key.encode("latin-1") + b"\0" + value.encode("latin-1"))
+                     for key, value in sorted((text or {}).items()))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + texts + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
+            + chunk(b"IEND", b""))
 
 
-def exr32_bytes(image: np.ndarray) -> bytes:
+def exr32_bytes(image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
     """32-bit float scanline OpenEXR, uncompressed, row 0 = bottom: channel 'Y' for (H, W),
     channels A, B, G, R (EXR stores them sorted by name) for (H, W, 4) RGBA."""
     img = np.asarray(image, np.float32)[::-1]
@@ -237,6 +247,7 @@ def exr32_bytes(image: np.ndarray) -> bytes:
               + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
               + attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
               + attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
+              + b"".join(attr(key, "string", value.encode()) for key, value in sorted((text or {}).items()))
               + b"\0")
     line_bytes = 4 * w * len(names)
     block = 8 + line_bytes
@@ -251,12 +262,43 @@ def exr32_bytes(image: np.ndarray) -> bytes:
     return header + offsets + rows.tobytes()
 
 
-def encode_image(path: str | Path, image: np.ndarray) -> bytes:
-    """The file bytes of (H, W) accessibility, or (H, W, 4) RGBA, for path's format."""
+def encode_image(path: str | Path, image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
+    """The file bytes of (H, W) accessibility, or (H, W, 4) RGBA, for path's format, with
+    text entries (keyword -> value) in its metadata."""
     fmt = format_for_path(path)
     if not np.isfinite(image).all():
         raise ValueError("refusing to write an AO map containing NaN or Inf")
-    return png16_bytes(image) if fmt == "PNG" else exr32_bytes(image)
+    return png16_bytes(image, text) if fmt == "PNG" else exr32_bytes(image, text)
+
+
+def read_text(path: str | Path, keyword: str) -> str | None:
+    """A text entry of a PNG (tEXt) or EXR (string attribute) file this module wrote, or None
+    (no such entry, another format, a truncated or unreadable file). Reads the header only."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError:
+        return None
+    if head.startswith(b"\x89PNG\r\n\x1a\n"):
+        at = 8
+        while at + 8 <= len(head):
+            length, tag = struct.unpack(">I4s", head[at:at + 8])
+            if tag in (b"IDAT", b"IEND"):
+                return None
+            payload = head[at + 8:at + 8 + length]
+            if tag == b"tEXt" and payload.split(b"\0", 1)[0] == keyword.encode("latin-1"):
+                return payload.split(b"\0", 1)[1].decode("latin-1")
+            at += 12 + length
+        return None
+    if head.startswith(struct.pack("<i", 20000630)):
+        marker = keyword.encode() + b"\0string\0"
+        at = head.find(marker)
+        if at < 0:
+            return None
+        (size,) = struct.unpack("<i", head[at + len(marker):at + len(marker) + 4])
+        start = at + len(marker) + 4
+        return head[start:start + size].decode(errors="replace")
+    return None
 
 
 def write_ao_file(path: str | Path, image: np.ndarray) -> None:

@@ -1,0 +1,131 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Farm benchmark (issue 29): what running bakes as Open Job Description tasks costs against
+one local batch, in one run on one machine.
+
+    .venv/bin/python bench/farm_bench.py [--inputs 50] [--out bench/results]
+
+Rows, each timed once end to end (process start, Blender, GPU context, shaders included):
+- local batch: `bake` of N inputs in one process (--out-dir);
+- one farm task: the same N inputs as one chunk, run by `openjd run --step Bake` as a farm
+  worker runs a task (the issue's target: at most 1.1x the local batch);
+- one task per input: N chunks of 1, each its own `openjd run` (what a chunk saves);
+- writing the bundle of 10,000 inputs (`farm openjd`, which loads no Blender; target 5 s).
+The inputs are Spot scaled by 1 + k/1000 (no input is a cached re-bake of another), baked at
+256^2 with 64 directions. Writes farm_bench.json and farm_bench.png into the output folder.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SPOT = ROOT / "samples" / "spot.obj"
+OPENJD = Path(sys.executable).parent / "openjd"
+BAKE = ["--size", "256", "--directions", "64", "--margin", "4"]
+BUNDLE_INPUTS = 10_000
+
+
+def run(args: list, cwd: Path) -> float:
+    """Seconds of one command, which must succeed."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    t0 = time.perf_counter()
+    done = subprocess.run([str(a) for a in args], capture_output=True, text=True, env=env, cwd=cwd)
+    seconds = time.perf_counter() - t0
+    if done.returncode != 0:
+        raise SystemExit(f"{args[:4]} failed: {done.stderr[-2000:]}{done.stdout[-2000:]}")
+    return seconds
+
+
+def write_inputs(folder: Path, count: int) -> list[Path]:
+    lines = SPOT.read_text().splitlines()
+    paths = []
+    for k in range(count):
+        scale = 1.0 + k / 1000.0
+        path = folder / f"spot{k:03d}.obj"
+        path.write_text("\n".join("v " + " ".join(f"{float(x) * scale:.7g}" for x in line.split()[1:4])
+                                  if line.startswith("v ") else line for line in lines) + "\n")
+        paths.append(path)
+    return paths
+
+
+def hao(*args) -> list:
+    return [sys.executable, "-m", "hao_addon", *args]
+
+
+def task_runs(bundle: Path, chunks: int, cwd: Path) -> float:
+    """Seconds of every Bake task of a bundle, each its own `openjd run` (as a farm runs them)."""
+    params = f"file://{bundle / 'job_parameters.json'}"
+    return sum(run([OPENJD, "run", bundle / "template.json", "--job-param", params, "--step", "Bake", "-tp",
+                    f"Chunk={k}"], cwd) for k in range(chunks))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--inputs", type=int, default=50)
+    ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
+    opts = ap.parse_args()
+    out = Path(opts.out)
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as scratch:
+        tmp = Path(scratch)
+        (tmp / "in").mkdir()
+        inputs = write_inputs(tmp / "in", opts.inputs)
+        rows = {}
+        folders = {name: tmp / name for name in ("local", "task", "tasks")}
+        for folder in folders.values():
+            folder.mkdir()
+        rows["local batch"] = run(hao("bake", *inputs, "--out-dir", folders["local"], *BAKE, "--quiet"), tmp)
+        farm = ["--runner", "python", "--executable", sys.executable, *BAKE]
+        run(hao("farm", "openjd", *inputs, "--out-dir", folders["task"], "--bundle", tmp / "one",
+                "--chunk-size", opts.inputs, *farm), tmp)
+        rows["one farm task"] = task_runs(tmp / "one", 1, tmp)
+        run(hao("farm", "openjd", *inputs, "--out-dir", folders["tasks"], "--bundle", tmp / "each",
+                "--chunk-size", "1", *farm), tmp)
+        rows["one task per input"] = task_runs(tmp / "each", opts.inputs, tmp)
+        same = all((folders["task"] / p.name).read_bytes() == p.read_bytes() for p in folders["local"].iterdir())
+        (tmp / "many").mkdir()
+        for k in range(BUNDLE_INPUTS):
+            (tmp / "many" / f"m{k:05d}.obj").write_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        many = sorted((tmp / "many").iterdir())
+        bundle_seconds = run(hao("farm", "openjd", *many, "--out-dir", tmp / "o", "--bundle", tmp / "big",
+                                 "--chunk-size", "10"), tmp)
+    result = {
+        "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": sys.version.split()[0]},
+        "inputs": opts.inputs, "bake_options": BAKE, "seconds": {k: round(v, 3) for k, v in rows.items()},
+        "ratio_one_task_to_local_batch": round(rows["one farm task"] / rows["local batch"], 3),
+        "ratio_task_per_input_to_local_batch": round(rows["one task per input"] / rows["local batch"], 3),
+        "task_outputs_equal_local_batch": same,
+        "bundle_inputs": BUNDLE_INPUTS, "bundle_seconds": round(bundle_seconds, 3),
+    }
+    (out / "farm_bench.json").write_text(json.dumps(result, indent=2) + "\n")
+    plot(result, out / "farm_bench.png")
+    print(json.dumps(result, indent=2))
+
+
+def plot(result: dict, path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names, seconds = zip(*result["seconds"].items())
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    bars = ax.barh(names, seconds, color=["#4c72b0", "#55a868", "#c44e52"])
+    for bar, value in zip(bars, seconds):
+        ax.text(bar.get_width(), bar.get_y() + bar.get_height() / 2, f" {value:.1f} s", va="center")
+    ax.set_xlabel(f"seconds for {result['inputs']} inputs ({' '.join(result['bake_options'])})")
+    ax.set_title(f"Farm tasks against one local batch (bundle of {result['bundle_inputs']:,} inputs: "
+                 f"{result['bundle_seconds']:.1f} s)", fontsize=10)
+    ax.invert_yaxis()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+if __name__ == "__main__":
+    main()

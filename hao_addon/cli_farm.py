@@ -1,0 +1,208 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""``hao farm openjd|flamenco|opencue INPUT... --out-dir DIR --bundle DIR [bake options]``:
+a bake job in a farm's own format, every task the workstation's ``bake`` over one chunk
+of the job's manifest; ``hao farm verify``: a job's check that every output exists.
+
+Writing a job loads no mesh and no Blender (10,000 inputs take seconds); the bake options
+given reach every task unchanged (forwarded_options).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from . import __version__
+from .cli_io import Report
+from .core.farm import flamenco, openjd, opencue
+from .core.farm.manifest import Manifest, make_manifest, read_manifest
+from .core.farm.tasks import RUNNERS
+from .core.imageio import atomic_write_bytes
+
+# The formats `farm` writes: (help, the files' writer).
+FORMATS = {
+    "openjd": "an Open Job Description job bundle (AWS Deadline Cloud; 'openjd run' runs it locally)",
+    "flamenco": "a Flamenco job type (JavaScript) and the job's settings",
+    "opencue": "an OpenCue command file for cuecmd, one line per task",
+}
+# farm's own options (and the outputs the manifest carries): not forwarded to the tasks.
+FARM_OWN = frozenset({"command", "farm_command", "input", "out", "out_dir", "frames", "skip_existing", "json",
+                      "quiet", "bundle", "chunk_size", "runner", "executable", "addon_path", "name", "help"})
+DEFAULT_CHUNK = 10
+# The folder holding hao_addon: a python runner's PYTHONPATH.
+ADDON_FOLDER = str(Path(__file__).resolve().parent.parent)
+
+
+def add_farm_parsers(sub, add_bake_arguments, add_run_options) -> None:
+    farm = sub.add_parser("farm", help="write a bake job for a render farm (OpenJD, Flamenco, OpenCue)")
+    kinds = farm.add_subparsers(dest="farm_command", required=True)
+    for name, text in FORMATS.items():
+        p = kinds.add_parser(name, help=f"write {text}")
+        add_bake_arguments(p)
+        p.add_argument("--bundle", required=True, metavar="DIR", help="the folder to write the job into")
+        p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK, metavar="N",
+                       help=f"inputs (or frames of --frames) per task (default {DEFAULT_CHUNK})")
+        p.add_argument("--runner", choices=tuple(RUNNERS), default="blender",
+                       help="how a worker runs hao: blender (a Blender with the extension: blender -b -c hao "
+                            "bake ...; default) or python (a Python with the bpy wheel: PATH -m hao_addon bake ...)")
+        p.add_argument("--executable", default=None, metavar="PATH",
+                       help="the runner's executable on the workers (a job parameter; default: 'blender', or this "
+                            "Python for --runner python)")
+        p.add_argument("--addon-path", default=ADDON_FOLDER, metavar="DIR",
+                       help="--runner python: the folder holding hao_addon on the workers (default: this one)")
+        p.add_argument("--name", default="HAO AO bake", help="the job's name")
+        add_run_options(p)
+    v = kinds.add_parser("verify", help="a job's last step: fail, naming them, if expected outputs are missing")
+    v.add_argument("--manifest", required=True, metavar="FILE")
+    v.add_argument("--out-dir", required=True, metavar="DIR")
+    add_run_options(v)
+
+
+def forwarded_options(args: argparse.Namespace) -> list[str]:
+    """The bake options given (those not at their defaults, and not farm's own), as
+    '--option=value' (a value may start with '-'), flags alone, repeatable ones repeated."""
+    from .cli import add_bake_arguments
+
+    bake = argparse.ArgumentParser(add_help=False)
+    add_bake_arguments(bake)
+    out = []
+    for action in bake._actions:  # noqa: SLF001 - argparse keeps its options there
+        if not action.option_strings or action.dest in FARM_OWN:
+            continue
+        value = getattr(args, action.dest, action.default)
+        if value == action.default:
+            continue
+        option = action.option_strings[-1]
+        if isinstance(action, argparse._StoreTrueAction):  # noqa: SLF001
+            out.append(option)
+        elif isinstance(action, argparse._AppendAction):  # noqa: SLF001
+            out += [f"{option}={_absolute_if_file(v)}" for v in value]
+        else:
+            out.append(f"{option}={value}")
+    return out
+
+
+def _absolute_if_file(value: str) -> str:
+    """A --high-poly file as an absolute path (a task runs in the farm's own folder)."""
+    return os.path.abspath(value) if Path(value).is_file() else value
+
+
+def run_farm(args, report: Report, progress) -> list[str]:
+    if args.farm_command == "verify":
+        return run_verify(args, report)
+    from .cli import BATCH_NAME, INPUT_FORMATS, CLIError, check_input
+    if not args.input:
+        raise CLIError(f"farm {args.farm_command} needs the INPUT files of the job")
+    if not args.out_dir:
+        raise CLIError(f"farm {args.farm_command} needs --out-dir DIR: where the tasks write the maps")
+    template = args.out or BATCH_NAME
+    if os.path.dirname(template):
+        raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
+    for path in args.input:
+        check_input(Path(path), INPUT_FORMATS)
+    manifest = make_manifest(args.input, args.chunk_size, template, args.frames or "")
+    options = forwarded_options(args)
+    bundle = Path(os.path.abspath(args.bundle))
+    bundle.mkdir(parents=True, exist_ok=True)
+    executable = args.executable or ("blender" if args.runner == "blender" else sys.executable)
+    values = {"input_root": manifest.root, "out_dir": os.path.abspath(args.out_dir),
+              "manifest": str(bundle / "manifest.json"), "executable": executable}
+    if args.runner == "python":
+        values["addon"] = os.path.abspath(args.addon_path)
+    extra = [v for v in args.high_poly or () if Path(v).is_file()]
+    files = {"manifest.json": manifest.to_json()}
+    files.update(_job_files(args.farm_command, manifest, args.runner, options, values, args.name, extra))
+    for name, text in files.items():
+        atomic_write_bytes(bundle / name, text.encode())
+    report.outputs += [str(bundle / name) for name in files]
+    report.settings = {"format": args.farm_command, "runner": args.runner, "chunk_size": args.chunk_size,
+                       "tasks": manifest.chunk_count, "bake_options": options, "hao": __version__}
+    return [f"hao: wrote the {args.farm_command} job of {len(manifest.entries)} inputs"
+            + (f" (frames {manifest.frames})" if manifest.frames else "")
+            + f" in {manifest.chunk_count} tasks -> {bundle}"]
+
+
+def _job_files(kind: str, manifest: Manifest, runner: str, options: list[str], values: dict, name: str,
+               extra_inputs: list[str]) -> dict[str, str]:
+    """{file name: text} of a job in the format kind."""
+    if kind == "openjd":
+        params = {k: values[k] for k in ("input_root", "out_dir", "manifest", "executable", "addon") if k in values}
+        return {"template.json": _json(openjd.job_template(manifest, runner, options, name, __version__)),
+                "parameter_values.json": _json(openjd.parameter_values(params)),
+                "job_parameters.json": _json(openjd.job_parameters(params)),
+                "asset_references.json": _json(openjd.asset_references(manifest, values["manifest"],
+                                                                       values["out_dir"], extra_inputs))}
+    if kind == "flamenco":
+        return {flamenco.SCRIPT_NAME: flamenco.job_type_script(manifest, runner, options, name, __version__),
+                "job.json": _json(flamenco.job_settings(values, name))}
+    return {opencue.COMMANDS_NAME: opencue.command_file(manifest, runner, options, values)}
+
+
+def _json(data) -> str:
+    return json.dumps(data, indent=2) + "\n"
+
+
+def take_manifest_chunk(args) -> None:
+    """A farm task's bake: its chunk's inputs (under --input-root, else the manifest's
+    root), the manifest's output name, the chunk's frames; --out-dir is required."""
+    from .cli import CLIError
+    if args.input:
+        raise CLIError("--manifest names the inputs: give no INPUT besides it")
+    if not args.out_dir:
+        raise CLIError("--manifest needs --out-dir DIR")
+    manifest = read_manifest(args.manifest)
+    root = args.input_root or manifest.root
+    args.input = [os.path.join(root, *entry.split("/")) for entry in manifest.chunk_inputs(args.chunk)]
+    args.out = manifest.out
+    args.frames = manifest.chunk_frames(args.chunk) or args.frames
+
+
+def expected_outputs(manifest: Manifest, out_dir: str) -> list[str]:
+    """Glob patterns of every file a job's Bake step writes ('{object}' and UDIM tiles as
+    wildcards), per input (and frame)."""
+    import glob
+
+    from .blender.paths import input_file_name
+    from .core.frame_ranges import parse_frames
+    from .core.output_files import FRAME_DIGITS, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
+    from .core.bake.udim import UDIM_TOKEN
+    frames = parse_frames(manifest.frames) if manifest.frames else [None]
+    out = []
+    for entry in manifest.entries:
+        name = manifest.out.replace(INPUT_TOKEN, input_file_name(entry))
+        if manifest.frames and FRAME_TOKEN not in name:
+            stem, ext = os.path.splitext(name)
+            name = f"{stem}_{FRAME_TOKEN}{ext}"
+        pattern = glob.escape(name).replace(glob.escape(OBJECT_TOKEN), "*").replace(glob.escape(UDIM_TOKEN), "*")
+        for frame in frames:
+            here = pattern if frame is None else pattern.replace(glob.escape(FRAME_TOKEN),
+                                                                 f"{frame:0{FRAME_DIGITS}d}")
+            out.append(os.path.join(glob.escape(out_dir), here))
+    return out
+
+
+def run_verify(args, report: Report) -> list[str]:
+    """Exit 1 naming the expected outputs that are missing or empty (a map, or its UDIM
+    tiles: name.1001.png ...)."""
+    import glob
+
+    from .cli import EXIT_FAILURE, CLIError
+    manifest = read_manifest(args.manifest)
+    missing, found = [], []
+    patterns = expected_outputs(manifest, os.path.abspath(args.out_dir))
+    for pattern in patterns:
+        stem, ext = os.path.splitext(pattern)
+        files = glob.glob(pattern) or glob.glob(f"{stem}.[0-9][0-9][0-9][0-9]{ext}")
+        if not files or any(os.path.getsize(f) == 0 for f in files):
+            missing.append(pattern)
+        found += files
+    report.outputs += sorted(found)
+    if missing:
+        shown = ", ".join(os.path.basename(m) for m in missing[:10]) + (" ..." if len(missing) > 10 else "")
+        raise CLIError(f"{len(missing)} of {len(patterns)} expected outputs are missing or empty: {shown}",
+                       code=EXIT_FAILURE)
+    return [f"hao: verified {len(found)} outputs of {len(manifest.entries)} inputs in {args.out_dir}"]
+
+
