@@ -4,11 +4,14 @@ one local batch, in one run on one machine.
 
     .venv/bin/python bench/farm_bench.py [--inputs 50] [--out bench/results]
 
-Rows, each timed once end to end (process start, Blender, GPU context, shaders included):
+Rows, timed end to end (process start, Blender, GPU context, shaders included); the first
+three interleaved, REPEATS times each, the median kept (the machine is shared):
 - local batch: `bake` of N inputs in one process (--out-dir);
-- one farm task: the same N inputs as one chunk, run by `openjd run --step Bake` as a farm
-  worker runs a task (the issue's target: at most 1.1x the local batch);
-- one task per input: N chunks of 1, each its own `openjd run` (what a chunk saves);
+- the task's command: the same N inputs as one chunk, the command an OpenJD task runs
+  (bake --manifest --chunk --skip-existing --progress openjd), started directly;
+- one farm task: that chunk run by `openjd run --step Bake` as a farm worker runs a task
+  (an OpenJD session around the command; the issue's target: at most 1.1x the local batch);
+- one task per input: N chunks of 1, each its own `openjd run`, once (what a chunk saves);
 - writing the bundle of 10,000 inputs (`farm openjd`, which loads no Blender; target 5 s).
 The inputs are Spot scaled by 1 + k/1000 (no input is a cached re-bake of another), baked at
 256^2 with 64 directions. Writes farm_bench.json and farm_bench.png into the output folder.
@@ -19,6 +22,7 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -30,6 +34,7 @@ SPOT = ROOT / "samples" / "spot.obj"
 OPENJD = Path(sys.executable).parent / "openjd"
 BAKE = ["--size", "256", "--directions", "64", "--margin", "4"]
 BUNDLE_INPUTS = 10_000
+REPEATS = 3
 
 
 def run(args: list, cwd: Path) -> float:
@@ -59,11 +64,26 @@ def hao(*args) -> list:
     return [sys.executable, "-m", "hao_addon", *args]
 
 
-def task_runs(bundle: Path, chunks: int, cwd: Path) -> float:
-    """Seconds of every Bake task of a bundle, each its own `openjd run` (as a farm runs them)."""
-    params = f"file://{bundle / 'job_parameters.json'}"
-    return sum(run([OPENJD, "run", bundle / "template.json", "--job-param", params, "--step", "Bake", "-tp",
-                    f"Chunk={k}"], cwd) for k in range(chunks))
+def task_runs(bundle: Path, chunks: int, cwd: Path, out: Path | None = None) -> float:
+    """Seconds of every Bake task of a bundle, each its own `openjd run` (as a farm runs them),
+    into the bundle's output folder or out."""
+    values = json.loads((bundle / "job_parameters.json").read_text())
+    if out is not None:
+        values["OutputDir"] = str(out)
+    (cwd / "params.json").write_text(json.dumps(values))
+    return sum(run([OPENJD, "run", bundle / "template.json", "--job-param", f"file://{cwd / 'params.json'}",
+                    "--step", "Bake", "-tp", f"Chunk={k}"], cwd) for k in range(chunks))
+
+
+def task_command(bundle: Path) -> list[str]:
+    """The first Bake task's command, its parameters filled in ('{out}' for the output folder)."""
+    template = json.loads((bundle / "template.json").read_text())
+    values = json.loads((bundle / "job_parameters.json").read_text())
+    action = template["steps"][0]["script"]["actions"]["onRun"]
+    words = [action["command"], *action["args"]]
+    for name, value in {**values, "OutputDir": "{out}"}.items():
+        words = [w.replace(f"{{{{Param.{name}}}}}", value) for w in words]
+    return [w.replace("{{Task.Param.Chunk}}", "0") for w in words]
 
 
 def main() -> None:
@@ -77,19 +97,26 @@ def main() -> None:
         tmp = Path(scratch)
         (tmp / "in").mkdir()
         inputs = write_inputs(tmp / "in", opts.inputs)
-        rows = {}
-        folders = {name: tmp / name for name in ("local", "task", "tasks")}
-        for folder in folders.values():
-            folder.mkdir()
-        rows["local batch"] = run(hao("bake", *inputs, "--out-dir", folders["local"], *BAKE, "--quiet"), tmp)
         farm = ["--runner", "python", "--executable", sys.executable, *BAKE]
-        run(hao("farm", "openjd", *inputs, "--out-dir", folders["task"], "--bundle", tmp / "one",
+        run(hao("farm", "openjd", *inputs, "--out-dir", tmp / "outputs", "--bundle", tmp / "one",
                 "--chunk-size", opts.inputs, *farm), tmp)
-        rows["one farm task"] = task_runs(tmp / "one", 1, tmp)
-        run(hao("farm", "openjd", *inputs, "--out-dir", folders["tasks"], "--bundle", tmp / "each",
+        command = task_command(tmp / "one")
+        times = {"local batch": [], "the task's command": [], "one farm task": []}
+        for k in range(REPEATS):  # interleaved, each into an empty folder
+            folders = {name: tmp / f"{name.replace(' ', '_')}{k}" for name in times}
+            for folder in folders.values():
+                folder.mkdir()
+            times["local batch"].append(run(hao("bake", *inputs, "--out-dir", folders["local batch"], *BAKE,
+                                                "--quiet"), tmp))
+            times["the task's command"].append(run([str(folders["the task's command"]) if a == "{out}" else a
+                                                    for a in command], tmp))
+            times["one farm task"].append(task_runs(tmp / "one", 1, tmp, folders["one farm task"]))
+        rows = {name: statistics.median(values) for name, values in times.items()}
+        run(hao("farm", "openjd", *inputs, "--out-dir", tmp / "each_out", "--bundle", tmp / "each",
                 "--chunk-size", "1", *farm), tmp)
         rows["one task per input"] = task_runs(tmp / "each", opts.inputs, tmp)
-        same = all((folders["task"] / p.name).read_bytes() == p.read_bytes() for p in folders["local"].iterdir())
+        local, task = (tmp / "local_batch0"), (tmp / "one_farm_task0")
+        same = all((task / p.name).read_bytes() == p.read_bytes() for p in local.iterdir())
         (tmp / "many").mkdir()
         for k in range(BUNDLE_INPUTS):
             (tmp / "many" / f"m{k:05d}.obj").write_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
@@ -99,6 +126,8 @@ def main() -> None:
     result = {
         "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": sys.version.split()[0]},
         "inputs": opts.inputs, "bake_options": BAKE, "seconds": {k: round(v, 3) for k, v in rows.items()},
+        "repeats": REPEATS, "runs": {k: [round(v, 3) for v in values] for k, values in times.items()},
+        "ratio_task_command_to_local_batch": round(rows["the task's command"] / rows["local batch"], 3),
         "ratio_one_task_to_local_batch": round(rows["one farm task"] / rows["local batch"], 3),
         "ratio_task_per_input_to_local_batch": round(rows["one task per input"] / rows["local batch"], 3),
         "task_outputs_equal_local_batch": same,
@@ -116,7 +145,7 @@ def plot(result: dict, path: Path) -> None:
 
     names, seconds = zip(*result["seconds"].items())
     fig, ax = plt.subplots(figsize=(7, 3.2))
-    bars = ax.barh(names, seconds, color=["#4c72b0", "#55a868", "#c44e52"])
+    bars = ax.barh(names, seconds, color=["#4c72b0", "#8172b2", "#55a868", "#c44e52"])
     for bar, value in zip(bars, seconds):
         ax.text(bar.get_width(), bar.get_y() + bar.get_height() / 2, f" {value:.1f} s", va="center")
     ax.set_xlabel(f"seconds for {result['inputs']} inputs ({' '.join(result['bake_options'])})")

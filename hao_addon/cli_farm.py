@@ -146,7 +146,8 @@ def _json(data) -> str:
 
 def take_manifest_chunk(args) -> None:
     """A farm task's bake: its chunk's inputs (under --input-root, else the manifest's
-    root), the manifest's output name, the chunk's frames; --out-dir is required."""
+    root), the manifest's output name, the chunk's frames; --out-dir is required (made
+    if missing)."""
     from .cli import CLIError
     if args.input:
         raise CLIError("--manifest names the inputs: give no INPUT besides it")
@@ -157,6 +158,11 @@ def take_manifest_chunk(args) -> None:
     args.input = [os.path.join(root, *entry.split("/")) for entry in manifest.chunk_inputs(args.chunk)]
     args.out = manifest.out
     args.frames = manifest.chunk_frames(args.chunk) or args.frames
+    # The job's output folder may not exist yet on a worker (tasks race to make it: exist_ok).
+    try:
+        os.makedirs(args.out_dir, exist_ok=True)
+    except OSError as exc:
+        raise CLIError(f"cannot make the output folder '{args.out_dir}': {exc.strerror or exc}") from None
 
 
 def expected_outputs(manifest: Manifest, out_dir: str) -> list[str]:

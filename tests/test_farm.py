@@ -323,3 +323,48 @@ def test_a_task_killed_at_any_moment_reruns_to_the_same_bytes(job_inputs, tmp_pa
                 assert hashlib.sha256(path.read_bytes()).hexdigest() == expected[path.name], (delay, path.name)
     assert subprocess.run(cut, capture_output=True, env=env, cwd=tmp_path, timeout=300).returncode == 0
     assert {k: v for k, v in digests(killed).items() if not k.startswith(".")} == expected
+
+
+BLENDER_COMMAND = r'''
+import importlib.util, json, os, sys
+import bpy
+root, args = sys.argv[1], json.loads(sys.argv[2])
+registered = {}
+bpy.utils.register_cli_command = lambda name, fn: registered.setdefault(name, fn)  # what Blender keeps
+spec = importlib.util.spec_from_file_location("hao_ext", os.path.join(root, "__init__.py"),
+                                              submodule_search_locations=[root])
+module = importlib.util.module_from_spec(spec)
+sys.modules["hao_ext"] = module
+spec.loader.exec_module(module)
+module.register()
+assert args[:3] == ["-b", "-c", "hao"], args  # blender -b -c hao <the command's arguments>
+code = registered[args[2]](args[3:])
+sys.stdout.flush()
+os._exit(code)
+'''
+
+
+def test_the_blender_runner_calls_the_extensions_command_with_the_same_bake(job_inputs, tmp_path):
+    """--runner blender: 'blender -b -c hao bake ...'. No Blender binary here: the task's
+    arguments after the executable go to the command the installed extension registers
+    (operators/cli_command.py), as Blender passes them, and bake what the python runner bakes."""
+    out = tmp_path / "out"
+    out.mkdir()
+    done = hao(["farm", "openjd", job_inputs / "a.obj", "--out-dir", out, "--bundle", tmp_path / "job", *BAKE],
+               tmp_path)
+    assert done.returncode == 0, done.stderr
+    template = json.loads((tmp_path / "job" / "template.json").read_text())
+    assert [p["name"] for p in template["parameterDefinitions"]] == ["InputRoot", "OutputDir", "Manifest",
+                                                                   "Executable"]
+    params = json.loads((tmp_path / "job" / "job_parameters.json").read_text())
+    assert params["Executable"] == "blender"
+    args = [a.replace("{{Param.Manifest}}", params["Manifest"]).replace("{{Param.InputRoot}}", params["InputRoot"])
+            .replace("{{Param.OutputDir}}", params["OutputDir"]).replace("{{Task.Param.Chunk}}", "0")
+            for a in template["steps"][0]["script"]["actions"]["onRun"]["args"]]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    run = subprocess.run([sys.executable, "-c", BLENDER_COMMAND, str(ROOT), json.dumps(args)], capture_output=True,
+                         text=True, env=env, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert os.listdir(out) == ["a_ao.png"] and "openjd_progress: 100.0" in run.stdout
+    local = hao(["bake", job_inputs / "a.obj", "--out", tmp_path / "a_ao.png", *BAKE], tmp_path)
+    assert local.returncode == 0 and (tmp_path / "a_ao.png").read_bytes() == (out / "a_ao.png").read_bytes()
