@@ -12,6 +12,7 @@ import argparse
 import json
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from . import __version__
@@ -21,11 +22,47 @@ from .core.farm.manifest import Manifest, make_manifest, read_manifest
 from .core.farm.tasks import RUNNERS
 from .core.imageio import atomic_write_bytes
 
-# The formats `farm` writes: (help, the files' writer).
+
+@dataclass(frozen=True)
+class Job:
+    """What a job's files are made of (every format takes the same)."""
+
+    manifest: Manifest
+    runner: str
+    options: list  # the bake options, forwarded
+    values: dict  # the job's paths and executable: keys as openjd.PARAM's
+    name: str
+    extra_inputs: list  # --high-poly files, uploaded with the inputs
+
+
+def _openjd_files(job: Job) -> dict[str, str]:
+    params = {k: job.values[k] for k in openjd.PARAM if k in job.values}
+    return {"template.json": _json(openjd.job_template(job.manifest, job.runner, job.options, job.name, __version__)),
+            "parameter_values.json": _json(openjd.parameter_values(params)),
+            "job_parameters.json": _json(openjd.job_parameters(params)),
+            "asset_references.json": _json(openjd.asset_references(job.manifest, job.values["manifest"],
+                                                                   job.values["out_dir"], job.extra_inputs))}
+
+
+def _flamenco_files(job: Job) -> dict[str, str]:
+    return {flamenco.SCRIPT_NAME: flamenco.job_type_script(job.manifest, job.runner, job.options, job.name,
+                                                           __version__),
+            "job.json": _json(flamenco.job_settings(job.values, job.name))}
+
+
+def _opencue_files(job: Job) -> dict[str, str]:
+    return {opencue.COMMANDS_NAME: opencue.command_file(job.manifest, job.runner, job.options, job.values)}
+
+
+def _json(data) -> str:
+    return json.dumps(data, indent=2) + "\n"
+
+
+# The formats `farm` writes: (help, the job's files {name: text} besides manifest.json).
 FORMATS = {
-    "openjd": "an Open Job Description job bundle (AWS Deadline Cloud; 'openjd run' runs it locally)",
-    "flamenco": "a Flamenco job type (JavaScript) and the job's settings",
-    "opencue": "an OpenCue command file for cuecmd, one line per task",
+    "openjd": ("an Open Job Description job bundle (AWS Deadline Cloud; 'openjd run' runs it locally)", _openjd_files),
+    "flamenco": ("a Flamenco job type (JavaScript) and the job's settings", _flamenco_files),
+    "opencue": ("an OpenCue command file for cuecmd, one line per task", _opencue_files),
 }
 # farm's own options (and the outputs the manifest carries): not forwarded to the tasks.
 FARM_OWN = frozenset({"command", "farm_command", "input", "out", "out_dir", "frames", "skip_existing", "json",
@@ -38,7 +75,7 @@ ADDON_FOLDER = str(Path(__file__).resolve().parent.parent)
 def add_farm_parsers(sub, add_bake_arguments, add_run_options) -> None:
     farm = sub.add_parser("farm", help="write a bake job for a render farm (OpenJD, Flamenco, OpenCue)")
     kinds = farm.add_subparsers(dest="farm_command", required=True)
-    for name, text in FORMATS.items():
+    for name, (text, _writer) in FORMATS.items():
         p = kinds.add_parser(name, help=f"write {text}")
         add_bake_arguments(p)
         p.add_argument("--bundle", required=True, metavar="DIR", help="the folder to write the job into")
@@ -111,9 +148,9 @@ def run_farm(args, report: Report, progress) -> list[str]:
               "manifest": str(bundle / "manifest.json"), "executable": executable}
     if args.runner == "python":
         values["addon"] = os.path.abspath(args.addon_path)
-    extra = [v for v in args.high_poly or () if Path(v).is_file()]
-    files = {"manifest.json": manifest.to_json()}
-    files.update(_job_files(args.farm_command, manifest, args.runner, options, values, args.name, extra))
+    extra = [os.path.abspath(v) for v in args.high_poly or () if Path(v).is_file()]
+    job = Job(manifest, args.runner, options, values, args.name, extra)
+    files = {"manifest.json": manifest.to_json(), **FORMATS[args.farm_command][1](job)}
     for name, text in files.items():
         atomic_write_bytes(bundle / name, text.encode())
     report.outputs += [str(bundle / name) for name in files]
@@ -122,26 +159,6 @@ def run_farm(args, report: Report, progress) -> list[str]:
     return [f"hao: wrote the {args.farm_command} job of {len(manifest.entries)} inputs"
             + (f" (frames {manifest.frames})" if manifest.frames else "")
             + f" in {manifest.chunk_count} tasks -> {bundle}"]
-
-
-def _job_files(kind: str, manifest: Manifest, runner: str, options: list[str], values: dict, name: str,
-               extra_inputs: list[str]) -> dict[str, str]:
-    """{file name: text} of a job in the format kind."""
-    if kind == "openjd":
-        params = {k: values[k] for k in ("input_root", "out_dir", "manifest", "executable", "addon") if k in values}
-        return {"template.json": _json(openjd.job_template(manifest, runner, options, name, __version__)),
-                "parameter_values.json": _json(openjd.parameter_values(params)),
-                "job_parameters.json": _json(openjd.job_parameters(params)),
-                "asset_references.json": _json(openjd.asset_references(manifest, values["manifest"],
-                                                                       values["out_dir"], extra_inputs))}
-    if kind == "flamenco":
-        return {flamenco.SCRIPT_NAME: flamenco.job_type_script(manifest, runner, options, name, __version__),
-                "job.json": _json(flamenco.job_settings(values, name))}
-    return {opencue.COMMANDS_NAME: opencue.command_file(manifest, runner, options, values)}
-
-
-def _json(data) -> str:
-    return json.dumps(data, indent=2) + "\n"
 
 
 def take_manifest_chunk(args) -> None:
