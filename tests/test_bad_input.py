@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Table-driven bad input: every class gets one clear line and loses nothing.
 
-Command line (``bake``, ``render-ao``): the exit code, stderr exactly one ``hao: error:`` line
-naming the problem, nothing on stdout, no file in the output folder or the temporary folder
-(Blender's own ``blender_*`` included), and every input file unchanged. Operators: the
+Command line (``bake``, ``render-ao``, ``farm``): the exit code, stderr exactly one
+``hao: error:`` line naming the problem, nothing on stdout, no file in the output folder or
+the temporary folder (Blender's own ``blender_*`` included), and every input file unchanged.
+The cases run as processes of their own, as many at once as there are cores (cli_runs). Operators: the
 report, and the scene unchanged (no image, UV map, attribute or material added).
 """
 from __future__ import annotations
@@ -15,6 +16,7 @@ import re
 import shutil
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -388,27 +390,49 @@ def run_cli(args: list[str], tmp: Path, **kw) -> subprocess.CompletedProcess:
                           cwd=kw.pop("cwd", tmp), timeout=300, **kw)
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
-def test_cli_bad_input(inputs, tmp_path, case):
-    _name, template, code, message = case
-    out, tmp = tmp_path / "out", tmp_path / "tmp"
+def _case_args(case, inputs: Path, folder: Path) -> tuple[list[str], str, Path, Path]:
+    """(arguments, message) of a case with its tokens filled, and its output and temporary
+    folders (made here, empty)."""
+    _name, template, _code, message = case
+    out, tmp = folder / "out", folder / "tmp"
     out.mkdir()
     tmp.mkdir()
-    subs = {"{in}": str(inputs), "{out}": str(out), "{locked}": str(unwritable_folder(tmp_path))}
-    args = []
+    subs = {"{in}": str(inputs), "{out}": str(out), "{locked}": str(unwritable_folder(folder))}
+    filled = []
     for arg in template + [message]:
         for token, value in subs.items():
             arg = arg.replace(token, value)
-        args.append(arg)
-    args, message = args[:-1], args[-1]
+        filled.append(arg)
+    return filled[:-1], filled[-1], out, tmp
+
+
+@pytest.fixture(scope="module")
+def cli_runs(inputs, tmp_path_factory) -> tuple[dict, dict]:
+    """Every case run once, as many at a time as there are cores (each is a process of its
+    own, mostly Python's and Blender's start on one core), each in its own folders; and the
+    inputs' digest before them all (each case checks it after them all)."""
     before = digest(inputs)
-    proc = run_cli(args, tmp)
+    prepared = {case[0]: _case_args(case, inputs, tmp_path_factory.mktemp(case[0])) for case in CASES}
+
+    def run(name: str):
+        args, _message, _out, tmp = prepared[name]
+        return name, run_cli(args, tmp)
+    with ThreadPoolExecutor(max_workers=os.cpu_count() or 2) as pool:
+        done = dict(pool.map(run, prepared))
+    return {name: (done[name], *prepared[name][1:]) for name in prepared}, before
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_cli_bad_input(inputs, cli_runs, case):
+    name, _template, code, _message = case
+    results, before = cli_runs
+    proc, message, out, tmp = results[name]
     assert proc.returncode == code, (proc.returncode, proc.stderr)
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("hao: error: ") and message in lines[0], proc.stderr
     assert proc.stdout == ""
     assert list(out.iterdir()) == [] and list(tmp.iterdir()) == [], (list(out.iterdir()), list(tmp.iterdir()))
-    assert digest(inputs) == before
+    assert digest(inputs) == before  # no case changed an input (all of them have run)
 
 
 def test_enough_classes():
