@@ -34,6 +34,7 @@ EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
 # extension, cleaned for file names as object names are).
 BATCH_NAME = "{input}_ao.png"  # several meshes of an input: _{object} is added
 INPUT_FORMATS = (".obj", ".glb", ".gltf", ".blend")
+GLTF_OUT = "the glTF file (--gltf-out)"  # its name in collision messages
 DEBUG_ENV = "HAO_DEBUG"  # set to 1: an internal error also prints its traceback and Blender's log
 
 
@@ -338,7 +339,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     """Bake; returns the summary lines to print."""
     import bpy
 
-    from .blender.bake_job import BakeJob, BakeRequest, output_path_for, validate_request
+    from .blender.bake_job import BakeJob, BakeRequest, output_path_for
     from .cli_skip import run_key, skip_finished
     from .core.imageio import BAKE_KEY
     from .blender.color_attributes import AO_ATTRIBUTE
@@ -409,13 +410,15 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                           extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
                           extra_outputs=writes, claimed=list(getattr(args, "batch_outputs", [])),
                           file_text={BAKE_KEY: key})
-    skip_lines = []
-    if args.skip_existing:
-        validate_request(request)  # a run that would be refused is refused, finished or not
-        request, skip_lines = skip_finished(request, key, report)
-        if request is None:
-            return skip_lines
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
+    skip_lines = []
+    if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
+        left, skip_lines = skip_finished(request, key, report)
+        if left is None:
+            return skip_lines
+        if left is not request:  # the frames still missing
+            request = left
+            job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
     start_gpu()
     t0 = time.perf_counter()
     try:
@@ -495,7 +498,7 @@ def _bake_files(args, source: Path, mesh_out: Path | None, gltf_out: Path | None
     if mesh_out is not None:
         writes.append((str(mesh_out), "the mesh file (--out)"))
     if gltf_out is not None:
-        writes.append((str(gltf_out), "the glTF file (--gltf-out)"))
+        writes.append((str(gltf_out), GLTF_OUT))
     return reads, writes
 
 
@@ -644,7 +647,7 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     planned = [(args.json or "", REPORT)]
     for sub in subs:
         planned += [(p, f"{what} of input '{sub.input}'") for p, what in _image_outputs(sub, _to_colors(sub))
-                    + [(sub.gltf_out or "", "the glTF file (--gltf-out)")] if not _has_token(p)]
+                    + [(sub.gltf_out or "", GLTF_OUT)] if not _has_token(p)]
     check_output_files(planned, reads)
     lines, written = [], []
     for index, sub in enumerate(subs):

@@ -189,19 +189,17 @@ def expected_outputs(manifest: Manifest, out_dir: str) -> list[str]:
 
     from .blender.paths import input_file_name
     from .core.frame_ranges import parse_frames
-    from .core.output_files import FRAME_DIGITS, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
+    from .core.output_files import FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN, frame_file, with_token
     from .core.bake.udim import UDIM_TOKEN
     frames = parse_frames(manifest.frames) if manifest.frames else [None]
     out = []
     for entry in manifest.entries:
         name = manifest.out.replace(INPUT_TOKEN, input_file_name(entry))
-        if manifest.frames and FRAME_TOKEN not in name:
-            stem, ext = os.path.splitext(name)
-            name = f"{stem}_{FRAME_TOKEN}{ext}"
-        pattern = glob.escape(name).replace(glob.escape(OBJECT_TOKEN), "*").replace(glob.escape(UDIM_TOKEN), "*")
+        if manifest.frames:
+            name = with_token(name, FRAME_TOKEN)  # as the bake names a sequence's files
         for frame in frames:
-            here = pattern if frame is None else pattern.replace(glob.escape(FRAME_TOKEN),
-                                                                 f"{frame:0{FRAME_DIGITS}d}")
+            here = glob.escape(name if frame is None else frame_file(name, frame))
+            here = here.replace(glob.escape(OBJECT_TOKEN), "*").replace(glob.escape(UDIM_TOKEN), "*")
             out.append(os.path.join(glob.escape(out_dir), here))
     return out
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import replace
 from pathlib import Path
 
 from . import __version__
@@ -46,18 +47,17 @@ def run_key(args, input_files: list[Path]) -> str:
 
 
 def skip_finished(request, key: str, report) -> tuple[object | None, list[str]]:
-    """(the request left to bake: None when every file is current, else the request with
-    only the frames still missing; the summary lines of what was skipped). The skipped
+    """(the request left to bake: None when every file is current, the request itself when
+    none is, else a copy with only the frames still missing; the summary lines of what was
+    skipped). The skipped
     files are listed in report.outputs and report.skipped; a sequence's skipped frames in
     report.frames (with skipped: true)."""
-    from dataclasses import replace
-
     from .blender.bake_job import finished_files
     from .cli_io import REPORT
     # The report is written by every run, finished or not: not a file the bake must find.
-    request = replace(request, extra_outputs=[entry for entry in request.extra_outputs if entry[1] != REPORT])
+    wanted = replace(request, extra_outputs=[entry for entry in request.extra_outputs if entry[1] != REPORT])
     if not request.frames:
-        done = finished_files(request, key)
+        done = finished_files(wanted, key)
         if done is None:
             return request, []
         report.outputs.extend(done)
@@ -65,15 +65,16 @@ def skip_finished(request, key: str, report) -> tuple[object | None, list[str]]:
         return None, [f"hao: skipped {_names(request)}: {_files(len(done))} current, kept"]
     left = []
     for frame in request.frames:
-        done = finished_files(request, key, frame)
+        done = finished_files(wanted, key, frame)
         if done is None:
             left.append(frame)
             continue
         report.skipped.extend(done)
         report.frames.append(dict(frame=frame, seconds=0.0, reused=False, skipped=True, outputs=done))
-    skipped = len(request.frames) - len(left)
-    lines = [f"hao: skipped {skipped} of {len(request.frames)} frames of {_names(request)}: their files are "
-             f"current"] if skipped else []
+    if len(left) == len(request.frames):
+        return request, []
+    lines = [f"hao: skipped {len(request.frames) - len(left)} of {len(request.frames)} frames of "
+             f"{_names(request)}: their files are current"]
     if not left:
         report.outputs.extend(path for entry in report.frames for path in entry["outputs"])
         return None, lines

@@ -24,7 +24,7 @@ import numpy as np
 from .. import compat
 from ..bake import BakeResult, bake_key, bake_steps
 from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
-from ..core.output_files import check_output_files
+from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
@@ -34,7 +34,7 @@ from ..core.bake.udim import tile_path, udim_layout
 from ..core.geometry import face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
-from .paths import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
+from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
 OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
@@ -120,16 +120,14 @@ def output_path_for(request: BakeRequest, obj, filepath: str | None = None, fram
     if not filepath:
         return ""
     path = absolute_path(filepath)
-    if request.frames and FRAME_TOKEN not in path:
-        stem, ext = os.path.splitext(path)
-        path = f"{stem}_{FRAME_TOKEN}{ext}"
+    if request.frames:
+        path = with_token(path, FRAME_TOKEN)
     if frame is not None:
-        path = path.replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}")
+        path = frame_file(path, frame)
     if request.texture_set:
         return path.replace(OBJECT_TOKEN, TEXTURE_SET_NAME)
-    if len(request.targets) > 1 and OBJECT_TOKEN not in path:
-        stem, ext = os.path.splitext(path)
-        path = f"{stem}_{OBJECT_TOKEN}{ext}"
+    if len(request.targets) > 1:
+        path = with_token(path, OBJECT_TOKEN)
     return path.replace(OBJECT_TOKEN, object_file_name(obj))
 
 

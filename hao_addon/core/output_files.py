@@ -33,6 +33,20 @@ class OutputCollision(BakeInputError):
         self.parties = parties
 
 
+def with_token(path: str, token: str) -> str:
+    """path with token in it: as it is, or with '_' + token added before the extension
+    ('ao.png', '{frame}' -> 'ao_{frame}.png')."""
+    if token in path:
+        return path
+    stem, ext = os.path.splitext(path)
+    return f"{stem}_{token}{ext}"
+
+
+def frame_file(path: str, frame: int) -> str:
+    """path with its '{frame}' filled: the frame zero-padded to FRAME_DIGITS (Blender's ####)."""
+    return path.replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}")
+
+
 def file_key(path: str, _folders: dict[str, str] | None = None) -> str:
     """The identity of the file a path names: its folder resolved (links followed), then the
     name, case-folded. _folders caches resolved folders (thousands of frame files share one)."""
