@@ -12,8 +12,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source tools/bpy_releases.sh
 
+# nodejs: the tests compile the Flamenco job type (JavaScript) under node.
 APT_PACKAGES="libegl1 libegl-mesa0 libgl1-mesa-dri libgl1 libx11-6 libxi6 libxxf86vm1 libxfixes3 \
-libxrender1 libxkbcommon0 libsm6 libice6 libxext6"
+libxrender1 libxkbcommon0 libsm6 libice6 libxext6 nodejs"
 missing=""
 for p in $APT_PACKAGES; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
