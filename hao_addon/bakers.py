@@ -7,7 +7,7 @@ projection: the GPU's for the GPU bakers, mathutils' BVH for the reference (twin
 signature: core/bake/projection.project_steps)."""
 from __future__ import annotations
 
-BAKE_METHODS = ("scatter", "gather", "reference")
+from .core.bake.abilities import BAKE_METHODS  # the bakers' declarations (what each can bake)
 
 
 def baker_for(method: str):

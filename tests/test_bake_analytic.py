@@ -11,6 +11,7 @@ from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.reference import reference_accessibility
 from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.abilities import bakers_with
 
 R = 1.0
 
@@ -25,7 +26,7 @@ def floor_and_wall(width=2000.0, height=1000.0):
     return floor, scenes.wall(width, height, 0.0)
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with())
 @pytest.mark.parametrize("weighting", ["cosine", "uniform"])
 def test_lone_plane_is_exactly_open(gpu_context, method, weighting):
     plane = scenes.grid_plane(4.0, 8)
@@ -37,7 +38,7 @@ def test_lone_plane_is_exactly_open(gpu_context, method, weighting):
     np.testing.assert_allclose(res.ao[res.covered], 1.0, atol=1e-5)
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 @pytest.mark.parametrize("directions", [64, 256])
 def test_sphere_on_plane_matches_one_minus_r_over_d_cubed(gpu_context, method, directions):
     plane, sphere = sphere_on_plane()
@@ -51,7 +52,7 @@ def test_sphere_on_plane_matches_one_minus_r_over_d_cubed(gpu_context, method, d
     assert_within_sample_tolerance(stats, directions, f"{method} D={directions}")
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with())
 def test_floor_next_to_wall_unlimited(gpu_context, method):
     floor, wall = floor_and_wall()
     size, directions = (64 if method == "reference" else 128), 256
@@ -66,7 +67,7 @@ def test_floor_next_to_wall_unlimited(gpu_context, method):
     assert_within_sample_tolerance(error_stats(res.ao, ref, mask & res.covered), directions, method)
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with())
 @pytest.mark.parametrize("falloff", ["none", "wendland"])
 @pytest.mark.parametrize("max_distance", [0.5, 1.0])
 def test_floor_next_to_wall_with_max_distance(gpu_context, falloff, max_distance, method):
@@ -209,7 +210,7 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
     assert stats[1]["depth_faces_skipped"] == stats[1]["depth_faces_drawn"] == 0
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 def test_wendland_falloff_is_the_papers_kernel(gpu_context, method):
     """The GPU falloff (gpu_shaders/bake_falloff.glsl, shared by both variants) is
     w(x) = (1 - x)^4 (4x + 1), not a kernel of the same shape:
@@ -231,7 +232,7 @@ def test_wendland_falloff_is_the_papers_kernel(gpu_context, method):
     assert error_stats(mutant, ref, mask & res.covered)["bias"] > 4 * sigma(directions) / 8
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with())
 def test_every_baker_returns_the_estimators_sums(gpu_context, method):
     """The bakers find visibility their own way and return the plan's estimator sums per texel
     (core/bake/estimators.py): (size, size, channels), the weight sum last; for ambient

@@ -13,6 +13,7 @@ from hao_addon.core.objfile import obj_soup
 from hao_addon.core.reference import reference_accessibility
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.abilities import bakers_with
 
 SIZE, DIRS, REF_RAYS, TEXELS = 512, 128, 256, 400
 
@@ -34,7 +35,7 @@ def rocker():
     return soup, ys, xs, ref
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 def test_rocker_arm_matches_ray_traced_reference(gpu_context, rocker, method):
     soup, ys, xs, ref = rocker
     res = bake(soup, [], BakeSettings(size=SIZE, directions=DIRS, method=method), use_cache=False)

@@ -13,6 +13,7 @@ from hao_addon.core import scenes
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS
 from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.abilities import bakers_with
 from test_bake_analytic import floor_and_wall
 
 # The floor at the foot of an infinitely tall, wide wall sees the quarter-sphere away from
@@ -26,7 +27,7 @@ def angles_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.clip((a * b).sum(-1), -1.0, 1.0)))
 
 
-@pytest.mark.parametrize("method", ["gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with("bent-normals"))
 def test_lone_plane_bends_nowhere(gpu_context, method):
     """Nothing occludes: the bent normal is the normal, up to the direction set's own
     asymmetry (a Fibonacci set of 256 is symmetric about any axis to about 0.1 degree)."""
@@ -40,7 +41,7 @@ def test_lone_plane_bends_nowhere(gpu_context, method):
     np.testing.assert_allclose(res.ao[res.covered], 1.0, atol=1e-5)
 
 
-@pytest.mark.parametrize("method", ["gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with("bent-normals"))
 def test_floor_at_a_wall_leans_away_by_the_analytic_angle(gpu_context, method):
     floor, wall = floor_and_wall()
     size = 16 if method == "reference" else 64
@@ -64,7 +65,7 @@ def test_bent_normals_leave_the_ao_unchanged_and_need_a_gather(gpu_context):
     assert plain.bent_normals is None
     assert BakeSettings(max_distance=1.0, bent_normals=True).method_for(False) == "gather"
     assert BakeSettings(max_distance=1.0).method_for(False) == "scatter"
-    with pytest.raises(BakeInputError, match="scatter bakes ambient occlusion only"):
+    with pytest.raises(BakeInputError, match="histogram scatter cannot bake bent normals"):
         bake(floor, [wall], BakeSettings(method="scatter", bent_normals=True, **kw), use_cache=False)
 
 

@@ -26,10 +26,11 @@ from hao_addon.core.bake.vertex_target import indexed_vertex_target, vertex_targ
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.objfile import read_obj
+from hao_addon.core.bake.abilities import bakers_with
 
 ROOT = Path(__file__).resolve().parent.parent
 SPOT = ROOT / "samples" / "spot.obj"
-BACKENDS = ["gather", "reference"]
+BACKENDS = bakers_with("color-attribute")
 
 
 def colour_settings(method: str, **kw) -> BakeSettings:

@@ -24,8 +24,9 @@ from hao_addon.core.bake.projection import barycentric, drain, ray_starts
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 from hao_addon.gpu.util import live_pass_count
+from hao_addon.core.bake.abilities import bakers_with
 
-BACKENDS = ["gather", "reference"]
+BACKENDS = bakers_with("selected-to-active")
 R = 0.5  # the relief: a ball of radius R resting on a wide floor at z = 0
 SIZE = 96
 

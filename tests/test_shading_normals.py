@@ -16,9 +16,10 @@ from hao_addon.core.directions import bake_directions
 from hao_addon.core.geometry import TriangleSoup, smooth_vertex_normals
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
+from hao_addon.core.bake.abilities import bakers_with
 
-BACKENDS = ["scatter", "gather", "reference"]
-GPU_BACKENDS = ["scatter", "gather"]
+BACKENDS = bakers_with()
+GPU_BACKENDS = bakers_with(gpu_only=True)
 
 
 def tilted(normal_tilt_deg: float) -> TriangleSoup:

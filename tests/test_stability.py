@@ -11,6 +11,7 @@ from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.abilities import bakers_with
 
 SIZE, DIRS = 128, 128
 
@@ -83,7 +84,7 @@ def test_degenerate_triangles_nonmanifold_fin_and_zero_uv_area(unscaled, variant
     assert_same_map(unscaled[variant], res, f"{variant} degenerate")
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 def test_flipped_normals_bake_the_other_side(gpu_context, method):
     plane, sphere = base_scene()
     flipped = TriangleSoup(plane.positions[:, ::-1], plane.uvs[:, ::-1], name="flipped")
@@ -105,7 +106,7 @@ def test_overlapping_uv_islands_average(unscaled, variant):
     assert abs(float((res.ao[ok] - expected[ok]).mean())) < 2e-3
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 def test_4096_directions_no_overflow_or_precision_loss(gpu_context, method):
     plane, sphere = base_scene()
     d = 4096
@@ -123,7 +124,7 @@ def test_4096_directions_no_overflow_or_precision_loss(gpu_context, method):
     np.testing.assert_allclose(lone.ao[lone.covered], 1.0, atol=1e-5)
 
 
-@pytest.mark.parametrize("method", ["scatter", "gather"])
+@pytest.mark.parametrize("method", bakers_with(gpu_only=True))
 def test_4096_map(gpu_context, method):
     plane = scenes.grid_plane(2.0, 1)
     res = bake(plane, [], BakeSettings(size=4096, directions=16, margin=1, view_samples=1.0, method=method),

@@ -14,6 +14,7 @@ from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.udim import tile_path, udim_layout
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.geometry import TriangleSoup
+from hao_addon.core.bake.abilities import bakers_with
 
 SIZE = 64
 TILES = (1001, 1002, 1011)
@@ -181,7 +182,7 @@ def test_cli_writes_one_file_per_tile_and_refuses_gltf(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json", "udim.obj"]
 
 
-@pytest.mark.parametrize("method", ["gather", "reference"])
+@pytest.mark.parametrize("method", bakers_with("selected-to-active", "udim"))
 def test_selected_to_active_onto_udim_tiles(gpu_context, method):
     """A low-poly of two planes on tiles 1001 and 1002 over a ball on a floor: each tile holds
     the relief under its plane (the ball's darker than the open floor's), every texel found it."""

@@ -4,7 +4,8 @@
     python tools/readme_tables.py           # rewrite the tables in README.md
     python tools/readme_tables.py --check   # exit 1 if README.md differs (the tests do this)
 
-A table sits between ``<!-- settings:NAME -->`` and ``<!-- /settings:NAME -->``.
+A table sits between ``<!-- settings:NAME -->`` and ``<!-- /settings:NAME -->``; the
+bakers' abilities (core/bake/abilities.py) between ``<!-- settings:bakers -->`` and its end.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from hao_addon.core.setting_spec import specs  # noqa: E402
+from hao_addon.core.bake import abilities  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings  # noqa: E402
 
@@ -36,14 +38,39 @@ def table(*settings_classes) -> str:
     return "\n".join(rows)
 
 
+def bakers_table() -> str:
+    """Which method bakes what (the bakers' declarations), and why not where not."""
+    heads = [a.label for a in abilities.ABILITIES]
+    rows = ["| Method | Runs on | " + " | ".join(heads) + " |", "|---|---|" + "---|" * len(heads)]
+    for baker in abilities.BAKERS:
+        cells = ["yes" if baker.can(a.name) else "no" for a in abilities.ABILITIES]
+        where = "GPU" if baker.gpu else "CPU (for checking)"
+        rows.append(f"| `{baker.method}` | {where} | " + " | ".join(cells) + " |")
+    notes = [f"- The {baker.label} cannot bake {a.phrase}: {baker.cannot[a.name]}."
+             for baker in abilities.BAKERS for a in abilities.ABILITIES if not baker.can(a.name)]
+    phrases = {a.name: a.phrase for a in abilities.ABILITIES}
+    auto = [f"`{b.method}` when the bake needs {' and '.join(phrases[n] for n in sorted(b.auto_for))} and it can "
+            "bake the rest"
+            for b in abilities.BAKERS if b.gpu and b.auto_for]
+    fallback = next(b.method for b in abilities.BAKERS if b.gpu and not b.auto_for)
+    return "\n".join(rows + [""] + notes + ["", f"*Auto* picks {'; '.join(auto)}; otherwise `{fallback}`. "
+                                          "A method that cannot bake what is asked is refused before any work, "
+                                          "naming the methods that can."])
+
+
 def render(readme: str) -> str:
+    readme = _replace(readme, "bakers", bakers_table())
     for name, classes in TABLES.items():
-        pattern = re.compile(rf"(<!-- settings:{re.escape(name)} -->\n)(?:.*?\n)?(<!-- /settings:{re.escape(name)} -->)",
-                             re.S)
-        if not pattern.search(readme):
-            raise SystemExit(f"README.md has no <!-- settings:{name} --> block")
-        readme = pattern.sub(lambda m: m.group(1) + table(*classes) + "\n" + m.group(2), readme)
+        readme = _replace(readme, name, table(*classes))
     return readme
+
+
+def _replace(readme: str, name: str, text: str) -> str:
+    pattern = re.compile(rf"(<!-- settings:{re.escape(name)} -->\n)(?:.*?\n)?(<!-- /settings:{re.escape(name)} -->)",
+                         re.S)
+    if not pattern.search(readme):
+        raise SystemExit(f"README.md has no <!-- settings:{name} --> block")
+    return pattern.sub(lambda m: m.group(1) + text + "\n" + m.group(2), readme)
 
 
 def main(argv: list[str]) -> int:

@@ -240,6 +240,8 @@ def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff:
 class GatherBaker(LightViewBaker):
     """Owns the depth map, the texel list and its accumulators for one bake."""
 
+    METHOD = "gather"
+
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:
         """Texel list at one entry per texel (re-checked once the exact count is known),

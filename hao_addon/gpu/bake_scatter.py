@@ -24,8 +24,6 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from ..core.errors import BakeInputError
-from ..core.bake.estimators import AMBIENT_OCCLUSION
 from ..core.bake.plan import BakePlan
 from . import util
 from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
@@ -80,26 +78,7 @@ def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
 class ScatterBaker(LightViewBaker):
     """Owns the accumulator and the light-view targets of one bake."""
 
-    @classmethod
-    def check_limits(cls, plan: BakePlan) -> None:
-        """Also refuse Selected to Active: the scatter rasterizes the target's own triangles,
-        and high-poly points projected onto its texels are no triangles it could draw."""
-        if plan.projected is not None:
-            raise BakeInputError("the histogram scatter cannot bake Selected to Active (it draws the target's own "
-                                 "surface); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
-        if plan.udim is not None:
-            raise BakeInputError(f"the histogram scatter bakes one UV tile; these UVs lie on UDIM tiles "
-                                 f"{', '.join(map(str, plan.udim.tiles))}: use the gather (Shadow-Map Gather, also "
-                                 f"Auto's choice) or the reference")
-        if plan.vertex_target is not None:
-            raise BakeInputError("the histogram scatter cannot bake a colour attribute (it rasterizes the UV "
-                                 "layout); use the gather (Shadow-Map Gather, also Auto's choice) or the reference")
-        # Its accumulator packs (numerator, denominator) with numerator <= denominator in one
-        # word (gpu_shaders/bake_common.glsl): the ambient-occlusion estimator's sums only.
-        if plan.estimator is not AMBIENT_OCCLUSION:
-            raise BakeInputError(f"the histogram scatter bakes ambient occlusion only, not {plan.estimator.name}; "
-                                 f"use the gather (Shadow-Map Gather) or the reference")
-        super().check_limits(plan)
+    METHOD = "scatter"
 
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:

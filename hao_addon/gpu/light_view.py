@@ -220,8 +220,12 @@ class LightViewBaker(util.GPUPass):
     def bytes_needed(plan: BakePlan) -> int:
         raise NotImplementedError
 
+    METHOD = ""  # the bake method's name (core/bake/abilities.py declares what it can bake)
+
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:
+        """Refuse what the method cannot bake, or what exceeds the GPU's textures or memory."""
+        plan.check_method(cls.METHOD)
         util.check_texture_limits(plan.settings.size, plan.max_view_side, cls.bytes_needed(plan))
 
     def __init__(self, plan: BakePlan) -> None:

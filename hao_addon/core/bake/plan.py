@@ -16,6 +16,7 @@ from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
+from .abilities import check_method
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
@@ -108,6 +109,15 @@ class BakePlan:
         return (self.settings.size, self.settings.size)
 
     @property
+    def abilities_needed(self) -> frozenset[str]:
+        """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
+        return self.settings.abilities_needed(self.projected is not None, tiled=self.udim is not None)
+
+    def check_method(self, method: str) -> None:
+        """Refuse `method` if it cannot bake this plan (core/bake/abilities.py)."""
+        check_method(method, self.abilities_needed, asked_phrases(self.udim))
+
+    @property
     def estimator(self) -> Estimator:
         """What each direction adds to a receiver's sums (core/bake/estimators.py): ambient
         occlusion, with the bent normal's sums too where the settings ask for it."""
@@ -183,6 +193,11 @@ def pixel_jitter(seed: int, index: int) -> np.ndarray:
     return np.mod(start + index * _R2_STEP, 1.0)
 
 
+def asked_phrases(udim: UdimLayout | None) -> dict[str, str]:
+    """How a refusal names this bake's abilities where more precise than their phrase."""
+    return {} if udim is None else {"udim": f"UDIM tiles {', '.join(map(str, udim.tiles))}"}
+
+
 def _check_finite(soup: TriangleSoup) -> None:
     if not np.isfinite(soup.positions).all():
         bad = int((~np.isfinite(soup.positions)).any(axis=(1, 2)).sum())
@@ -244,6 +259,9 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
         uv_warnings, uv_counters = _layout_warnings(target, settings.size, udim)
     else:  # no UV layout: the light views are as fine as for a Size map over the bounding sphere
         uv_area, uv_warnings, uv_counters = None, [], {}
+    # A method that cannot bake what is asked is refused before the projection's rays.
+    needs = settings.abilities_needed(high_to_low is not None, tiled=udim is not None)
+    check_method(settings.method_for(high_to_low is not None, tiled=udim is not None), needs, asked_phrases(udim))
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)

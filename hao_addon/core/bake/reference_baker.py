@@ -35,6 +35,8 @@ MAX_REFERENCE_RAYS = 20_000_000
 class ReferenceBaker:
     """Ray-traced twin of the GPU bake passes for one plan."""
 
+    METHOD = "reference"
+
     @staticmethod
     def rays_needed(plan: BakePlan) -> int:
         """Rays of a whole bake at most (one per receiver and direction)."""
@@ -46,7 +48,9 @@ class ReferenceBaker:
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:
-        """Refuse a bake that would trace more than MAX_REFERENCE_RAYS rays."""
+        """Refuse what the reference cannot bake (core/bake/abilities.py; nothing today), or
+        a bake that would trace more than MAX_REFERENCE_RAYS rays."""
+        plan.check_method(cls.METHOD)
         rays = cls.rays_needed(plan)
         if rays > MAX_REFERENCE_RAYS:
             raise BakeInputError(

@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass
 
 from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
+from .abilities import abilities_needed, choose_method
 
 MAX_DIRECTIONS = 65536
 MAX_MAP_SIZE = 16384
@@ -133,14 +134,15 @@ class BakeSettings:
         return self.method_for(high_to_low=False)
 
     def method_for(self, high_to_low: bool, tiled: bool = False) -> str:
-        """The bake variant that runs: 'auto' is the gather, except with a max distance on the
-        target's own surface, where the scatter is (the benchmark's fastest at equal error);
-        Selected to Active, bent normals, colour attributes and UDIM tiles (tiled) always
-        gather (the scatter, which rasterizes one 0..1 UV layout, can bake none of them)."""
-        if self.method != "auto":
-            return self.method
-        scatter_can = not high_to_low and not self.bent_normals and self.target == "image" and not tiled
-        return "scatter" if self.max_distance > 0.0 and scatter_can else "gather"
+        """The bake variant that runs: the Method, or for 'auto' the bakers' declared choice
+        (core/bake/abilities.py: the scatter with a max distance where it can bake the rest
+        of what is asked, otherwise the gather). high_to_low: Selected to Active; tiled: the
+        UV layout lies on UDIM tiles."""
+        return choose_method(self.method, self.abilities_needed(high_to_low, tiled))
+
+    def abilities_needed(self, high_to_low: bool, tiled: bool = False) -> frozenset[str]:
+        """What a baker must be able to bake for these settings (core/bake/abilities.py)."""
+        return abilities_needed(self.max_distance, high_to_low, self.bent_normals, self.target, tiled)
 
     @property
     def sample_count(self) -> int:

@@ -1,0 +1,107 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The bakers' declared abilities (core/bake/abilities.py, issue 30 item 0): Auto's choice,
+the refusals and the factory come from one table, and the plan refuses a method before any
+work (a Selected-to-Active projection included)."""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from hao_addon.core import scenes
+from hao_addon.core.bake.abilities import (ABILITIES, ABILITY_NAMES, BAKE_METHODS, BAKERS, bakers_with,
+                                           choose_method, declaration)
+from hao_addon.core.bake.plan import make_plan
+from hao_addon.core.bake.projection import HighToLow
+from hao_addon.core.bake.settings import METHODS, BakeSettings
+from hao_addon.core.bake.vertex_target import indexed_vertex_target
+from hao_addon.core.errors import BakeInputError
+from hao_addon.core.geometry import TriangleSoup
+
+
+def plan_needing(ability: str, method: str):
+    """make_plan of a small scene that needs `ability` (and nothing else but what it implies)."""
+    plane = scenes.grid_plane(2.0, 4, name="plane")
+    kw = dict(size=32, directions=4, method=method)
+    if ability == "max-distance":
+        return make_plan(plane, [], BakeSettings(max_distance=1.0, **kw))
+    if ability == "selected-to-active":
+        def no_cast(*_args, **_kw):
+            raise AssertionError("the projection ran before the method was refused")
+        import bpy  # noqa: F401 - makes mathutils (the CPU cast's BVH) importable
+        from hao_addon.core.bake.projection import project_steps
+        cast = project_steps if declaration(method).can(ability) else no_cast
+        return make_plan(scenes.grid_plane(2.0, 2, z=0.5, name="low"), [], BakeSettings(**kw),
+                         high_to_low=HighToLow([plane]), cast=cast)
+    if ability == "bent-normals":
+        return make_plan(plane, [], BakeSettings(bent_normals=True, **kw))
+    if ability == "udim":
+        uvs = plane.uvs.copy()
+        uvs[: len(uvs) // 2, :, 0] += 1.0  # half the faces on tile 1002
+        return make_plan(TriangleSoup(plane.positions, uvs, "plane"), [], BakeSettings(**kw))
+    if ability == "color-attribute":
+        points = plane.positions.reshape(-1, 3)
+        verts, index = np.unique(points.round(9), axis=0, return_inverse=True)
+        return make_plan(TriangleSoup(plane.positions, None, "plane"), [], BakeSettings(target="color-attribute", **kw),
+                         vertex_target=indexed_vertex_target(index.reshape(-1, 3), len(verts)))
+    raise AssertionError(f"no scene needs {ability}")
+
+
+@pytest.mark.parametrize("baker,ability", [(b, a) for b in BAKERS for a in ABILITIES])
+def test_a_plan_is_refused_exactly_where_its_method_lacks_the_ability(baker, ability):
+    """Every (baker, ability): a bake needing it plans when the baker declares it, and is
+    refused before any work otherwise, naming what is asked, why, and the methods that can."""
+    if baker.can(ability.name):
+        plan = plan_needing(ability.name, baker.method)
+        assert ability.name in plan.abilities_needed
+        plan.check_method(baker.method)
+        return
+    with pytest.raises(BakeInputError) as refused:
+        plan_needing(ability.name, baker.method)
+    message = str(refused.value)
+    assert message.startswith(f"the {baker.label} cannot bake ")
+    assert baker.cannot[ability.name] in message
+    for other in bakers_with(ability.name):
+        assert f"the {declaration(other).label}" in message
+
+
+def test_udim_refusal_names_the_tiles():
+    with pytest.raises(BakeInputError, match="cannot bake UDIM tiles 1001, 1002 "):
+        plan_needing("udim", "scatter")
+
+
+def test_every_ability_has_a_gpu_baker_and_the_reference():
+    for name in ABILITY_NAMES:
+        assert bakers_with(name, gpu_only=True), name
+        assert "reference" in bakers_with(name), name  # the GPU bakers' truth bakes all of it
+
+
+def test_auto_takes_the_scatter_for_a_max_distance_alone_otherwise_the_gather():
+    """Auto's rule as the benchmark set it, over every combination of needs."""
+    for k in range(len(ABILITY_NAMES) + 1):
+        for needs in map(frozenset, itertools.combinations(ABILITY_NAMES, k)):
+            expected = "scatter" if needs == {"max-distance"} else "gather"
+            assert choose_method("auto", needs) == expected, needs
+            assert choose_method("reference", needs) == "reference"
+
+
+def test_settings_choose_through_the_declarations():
+    assert BakeSettings(max_distance=1.0).method_for(False) == "scatter"
+    assert BakeSettings(max_distance=1.0).method_for(True) == "gather"
+    assert BakeSettings(max_distance=1.0).method_for(False, tiled=True) == "gather"
+    assert BakeSettings(max_distance=1.0, target="color-attribute").method_for(False) == "gather"
+    assert BakeSettings().method_for(False) == "gather"
+
+
+def test_the_methods_setting_and_the_factory_list_the_declared_bakers():
+    from hao_addon.bakers import BAKE_METHODS as FACTORY_METHODS
+    assert METHODS == ("auto", *BAKE_METHODS) and FACTORY_METHODS == BAKE_METHODS
+    with pytest.raises(ValueError, match="unknown abilities"):
+        bakers_with("groups-by-name")
+
+
+def test_each_baker_class_is_its_declared_method(gpu_context):
+    from hao_addon.bakers import baker_for
+    for method in BAKE_METHODS:
+        assert baker_for(method).METHOD == method
