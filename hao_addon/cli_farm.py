@@ -100,7 +100,7 @@ def add_farm_parsers(sub, add_bake_arguments, add_run_options) -> None:
 def forwarded_options(args: argparse.Namespace) -> list[str]:
     """The bake options given (those not at their defaults, and not farm's own), as
     '--option=value' (a value may start with '-'), flags alone, repeatable ones repeated."""
-    from .cli import add_bake_arguments
+    from .cli_parser import add_bake_arguments
 
     bake = argparse.ArgumentParser(add_help=False)
     add_bake_arguments(bake)
@@ -129,7 +129,9 @@ def _absolute_if_file(value: str) -> str:
 def run_farm(args, report: Report, progress) -> list[str]:
     if args.farm_command == "verify":
         return run_verify(args, report)
-    from .cli import BATCH_NAME, INPUT_FORMATS, CLIError, check_input
+    from .cli_errors import CLIError
+    from .cli_parser import BATCH_NAME, INPUT_FORMATS
+    from .cli_scene import check_input
     if not args.input:
         raise CLIError(f"farm {args.farm_command} needs the INPUT files of the job")
     if not args.out_dir:
@@ -165,7 +167,7 @@ def take_manifest_chunk(args) -> None:
     """A farm task's bake: its chunk's inputs (under --input-root, else the manifest's
     root), the manifest's output name, the chunk's frames; --out-dir is required (made
     if missing)."""
-    from .cli import CLIError
+    from .cli_errors import CLIError
     if args.input:
         raise CLIError("--manifest names the inputs: give no INPUT besides it")
     if not args.out_dir:
@@ -209,7 +211,7 @@ def run_verify(args, report: Report) -> list[str]:
     tiles: name.1001.png ...)."""
     import glob
 
-    from .cli import EXIT_FAILURE, CLIError
+    from .cli_errors import EXIT_FAILURE, CLIError
     manifest = read_manifest(args.manifest)
     missing, found = [], []
     patterns = expected_outputs(manifest, os.path.abspath(args.out_dir))

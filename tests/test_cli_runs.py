@@ -279,12 +279,12 @@ def test_an_error_after_a_swallowed_signal_is_that_signal(signum, code):
     """A signal inside add-on registration is printed and swallowed by Blender; the glTF
     operator is then missing and the importer call fails. That failure is the signal's echo
     (CI once saw exit 1, 'internal error', for a SIGINT 0.6 s in)."""
-    from hao_addon import cli, cli_io
+    from hao_addon import cli_errors, cli_io
 
     cli_io._PENDING[:] = [signum]
     try:
-        got, message = cli._failure(AttributeError('Calling operator "bpy.ops.import_scene.gltf" error, '
-                                                    'could not be found'), None)
+        got, message = cli_errors.failure(AttributeError('Calling operator "bpy.ops.import_scene.gltf" error, '
+                                                          'could not be found'), None)
     finally:
         cli_io._PENDING.clear()
     assert got == code and message.endswith("nothing was written"), message
@@ -360,5 +360,5 @@ def test_bent_normal_out_writes_a_second_map_and_the_scatter_refuses(dirs):
     assert data["settings"]["bent_normals"] is True and (out / "spot_bent.exr").stat().st_size > 64 * 64 * 16
     proc = run(["bake", SPOT, "--size", "64", "--method", "scatter", "--out", out / "s.png",
                 "--bent-normal-out", out / "s_bent.png"], tmp)
-    assert proc.returncode == 2 and "scatter bakes ambient occlusion only" in proc.stderr, proc.stderr
+    assert proc.returncode == 2 and "histogram scatter cannot bake bent normals" in proc.stderr, proc.stderr
     assert not (out / "s.png").exists() and not (out / "s_bent.png").exists()

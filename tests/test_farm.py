@@ -154,7 +154,7 @@ def test_every_bake_option_reaches_each_task_unchanged(tmp_path):
                                                     "--chunk", "{{Task.Param.Chunk}}", "--input-root",
                                                     "{{Param.InputRoot}}", "--out-dir", "{{Param.OutputDir}}"]
     forwarded = args[args.index("openjd") + 1:]
-    from hao_addon.cli import build_parser
+    from hao_addon.cli_parser import build_parser
     parse = build_parser().parse_args
     given = vars(parse(["bake", str(SPOT), *options]))
     task = vars(parse(["bake", str(SPOT), *forwarded]))

@@ -12,7 +12,7 @@ import pytest
 
 import bpy
 from conftest import ROOT
-from hao_addon.cli import build_parser
+from hao_addon.cli_parser import build_parser
 from hao_addon.core.setting_spec import SettingError, check_value, specs
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings

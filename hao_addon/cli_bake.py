@@ -1,0 +1,231 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""`bake` of one input: check, load, bake, write all or nothing, report."""
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import asdict, replace
+from pathlib import Path
+
+from .cli_errors import CLIError
+from .cli_io import check_signals, deferred_signals, Progress, REPORT, Report
+from .cli_options import option_for, settings_from_args
+from .cli_parser import INPUT_FORMATS
+from .cli_scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
+                        export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
+from .core.frame_ranges import parse_frames
+from .core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
+from .core.setting_spec import SettingError
+
+
+GLTF_OUT = "the glTF file (--gltf-out)"  # its name in collision messages
+
+
+def run_bake(args, report: Report, progress: Progress) -> list[str]:
+    """Bake; returns the summary lines to print."""
+    import bpy
+
+    from .blender.bake_job import BakeJob, BakeRequest, output_path_for
+    from .cli_skip import run_key, skip_finished
+    from .core.imageio import BAKE_KEY
+    from .blender.color_attributes import AO_ATTRIBUTE
+    from .blender.paths import example_path, frame_pattern
+    from .core.imageio import check_writable
+    from .core.bake.settings import BakeSettings
+
+    settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
+    source = check_input(Path(args.input), INPUT_FORMATS)
+    frames = parse_frames(args.frames) if args.frames else None
+    first_frame = frames[0] if frames else 0
+    if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
+        settings = replace(settings, terminator="setting")
+    to_colors = settings.target == "color-attribute"
+    if to_colors and (args.bent_normal_out or args.gltf_out):
+        raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out "
+                       "(.blend, .glb or .ply); --bent-normal-out and --gltf-out are image bakes")
+    if args.bent_normal_out:
+        settings = replace(settings, bent_normals=True)
+        check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
+                       source=source)
+    gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
+    report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
+    report.input = str(source)
+    # Refused before a long load; checked again with the object's name once it is known.
+    mesh_out = check_mesh_target(args.out, source, MESH_OUT_FORMATS, "--out") if to_colors else None
+    if not to_colors:
+        check_writable(example_path(args.out, first_frame), settings.size, settings.size, 1, source=source)
+    check_json_target(args.json)
+    reads, writes = _bake_files(args, source, mesh_out, gltf_out)
+    literal = [(path, what) for path, what in image_outputs(args, to_colors) if not has_token(path)]
+    check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
+    key = run_key(args, [Path(path) for path, _what in reads])
+    with report.phase("load"):
+        progress.update("loading")
+        load_scene(source)
+    check_signals()
+    high_poly = pick_high_poly(args.high_poly) if args.high_poly else None
+    cage = pick_mesh(args.cage, "--cage") if args.cage else None
+    if cage is not None and high_poly is None:
+        raise CLIError("--cage needs --high-poly (Selected to Active)")
+    exclude = tuple(high_poly or ()) + ((cage,) if cage else ())
+    if args.all_meshes:
+        targets = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
+        if not targets:
+            raise CLIError("the input contains no mesh object")
+    else:
+        targets = [pick_target(name, exclude) for name in (args.object or [""])]
+    if len({o.name for o in targets}) != len(targets):
+        raise CLIError("--object names the same mesh twice")
+    if args.texture_set and len(targets) < 2:
+        raise CLIError("--texture-set bakes several meshes into one image: name them with --object (twice or more)")
+    if high_poly is not None and len(targets) > 1:
+        raise CLIError("Selected to Active bakes onto one low-poly: give one --object")
+    if high_poly is not None:
+        report.settings["high_poly"] = [o.name for o in high_poly]
+        report.settings["cage"] = cage.name if cage else ""
+    request = BakeRequest(targets=targets, settings=settings, texture_set=args.texture_set,
+                          frames=frames,
+                          occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
+                          uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
+                          filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
+                          source_path=str(source),
+                          high_poly=high_poly, cage=cage,
+                          bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
+                          bent_space=args.bent_space, bent_convention=args.bent_convention,
+                          wire_material=gltf_out is not None,
+                          extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
+                          extra_outputs=writes, claimed=list(getattr(args, "batch_outputs", [])),
+                          file_text={BAKE_KEY: key})
+    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
+    skip_lines = []
+    if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
+        left, skip_lines = skip_finished(request, key, report)
+        if left is None:
+            return skip_lines
+        if left is not request:  # the frames still missing
+            request = left
+            job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
+    start_gpu()
+    t0 = time.perf_counter()
+    try:
+        with report.phase("bake"):
+            for fraction, text in job.steps():
+                progress.update(text.split(":")[0], fraction if fraction > 0 else None)
+        check_signals()  # never commit a run that was asked to stop
+        if gltf_out is not None and any(result.tiles for _o, _u, result in job.results):
+            raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs baked lie on several; bake without "
+                           "--gltf-out")
+        with report.phase("write"):
+            job.commit(hold=True)  # all or nothing with the mesh files below: a failure puts back the maps
+            if mesh_out is not None:
+                export_mesh_file(targets, mesh_out, colors=True)
+            if gltf_out is not None:
+                export_glb(targets, gltf_out)
+            job.release()
+    except BaseException:
+        job.cancel()
+        _report_frames(job, report)  # a sequence's finished frames stay, and are listed
+        report.kept = job.written_note()
+        raise
+    report.timings["unwrap"] = round(job.unwrap_seconds, 4)
+    for obj, uv_name, result in job.results:
+        st = result.stats
+        report.objects.append(dict(name=obj.name, triangles=st["target_faces"],
+                                   uv_map=uv_name, uv_map_created=any(n == uv_name for _m, n in job.created_uv),
+                                   covered_texels=st["covered_texels"], method=st["method"],
+                                   smooth_corners=st["smooth_corners"],
+                                   **({"texture_set": True} if args.texture_set else {}),
+                                   **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
+                                   **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+    lines = skip_lines
+    for obj, label, result in job.baked():
+        st = result.stats
+        tile_files = job.files.get((label, "ao"), [])
+        if not request.frames:  # a sequence's files are listed frame by frame (_report_frames)
+            report.outputs.extend(tile_files if len(tile_files) > 1 else [output_path_for(request, obj)])
+            report.outputs.extend(job.files.get((label, "bent"), []))
+        report.warnings.extend(st.get("warnings", []))
+        uv_name = next(uv for o, uv, _r in job.results if o == obj)
+        where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
+                 f"'{AO_ATTRIBUTE}')" if to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
+        frames, dest = "", str(mesh_out) if to_colors else ", ".join(tile_files) or output_path_for(request, obj)
+        if request.frames:
+            reused = sum(e["reused"] for e in job.frame_results)
+            frames = f" x {len(request.frames)} frames ({reused} reused, same geometry)"
+            dest = frame_pattern(output_path_for(request, obj))
+        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {settings.directions} "
+                     f"directions{frames} in {time.perf_counter() - t0:.2f} s -> {dest}")
+    if gltf_out is not None:
+        report.outputs.append(str(gltf_out))
+    if request.frames:
+        _report_frames(job, report)
+    return lines
+
+
+def _report_frames(job, report: Report) -> None:
+    """A sequence's frames in the report, in frame order: those baked (all, or the finished
+    ones of a failed or interrupted run: they stay on disk) beside those --skip-existing
+    found current; outputs lists every frame's files."""
+    baked = [dict(frame=e["frame"], seconds=e["seconds"], reused=e["reused"], outputs=e["outputs"])
+             for e in job.frame_results]
+    report.frames = sorted(report.frames + baked, key=lambda entry: entry["frame"])
+    report.outputs.extend(path for entry in report.frames for path in entry["outputs"])
+
+
+def _bake_files(args, source: Path, mesh_out: Path | None, gltf_out: Path | None
+                ) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(what the bake reads, what it writes besides its maps), as (path, what) pairs for
+    core/output_files.py: the input and --high-poly files; the report, --gltf-out and a
+    colour bake's mesh file."""
+    reads = [(str(source), "the input file")]
+    reads += [(spec, f"the high-poly file '{spec}'") for spec in args.high_poly or ()
+              if Path(spec).suffix.lower() in INPUT_FORMATS and Path(spec).is_file()]
+    writes = [(args.json or "", REPORT)]
+    if mesh_out is not None:
+        writes.append((str(mesh_out), "the mesh file (--out)"))
+    if gltf_out is not None:
+        writes.append((str(gltf_out), GLTF_OUT))
+    return reads, writes
+
+
+def image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
+    """The image files named on the command line (patterns, tokens unfilled)."""
+    if to_colors:
+        return []
+    return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)")]
+
+
+def has_token(path: str) -> bool:
+    from .core.bake.udim import UDIM_TOKEN
+    return any(token in path for token in (OBJECT_TOKEN, FRAME_TOKEN, UDIM_TOKEN))
+
+
+def validated(settings, settings_cls):
+    """settings.validated(), naming the option in the message."""
+    try:
+        return settings.validated()
+    except SettingError as exc:
+        option = option_for(settings_cls, exc.name)
+        raise CLIError(f"{exc} ({option})" if option else str(exc)) from None
+
+
+def fill_input_token(args, path: str) -> None:
+    """{input} in the output options becomes the input's cleaned name (input_file_name)."""
+    from .blender.paths import input_file_name
+    name = input_file_name(path)
+    for option in ("out", "bent_normal_out", "gltf_out"):
+        value = getattr(args, option)
+        if value:
+            setattr(args, option, value.replace(INPUT_TOKEN, name))
+
+
+def to_colors(args) -> bool:
+    return getattr(args, "target", None) == "color-attribute"
+
+
+def start_gpu() -> None:
+    """Blender's GPU context, made while signals wait (an interrupt inside its creation, which
+    runs Python callbacks from C, is not safe)."""
+    from .blender.gpu_context import ensure_gpu_context
+    with deferred_signals():
+        ensure_gpu_context()

@@ -1,0 +1,71 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""`bake` of several inputs in one process (--out-dir)."""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from .cli_bake import fill_input_token, GLTF_OUT, has_token, image_outputs, run_bake, to_colors
+from .cli_errors import CLIError, failure
+from .cli_io import Progress, REPORT, Report, Terminated
+from .cli_parser import BATCH_NAME
+from .core.output_files import check_output_files, INPUT_TOKEN, OBJECT_TOKEN
+
+
+def run_batch(args, report: Report, progress: Progress) -> list[str]:
+    """Bake every input in this process (the GPU context, compiled shaders and caches carry
+    over), each into --out-dir; a failed input is reported and the next one baked. A signal
+    stops the batch at once. Returns the summary lines; report.inputs holds one report each."""
+    if args.out_dir is None:
+        raise CLIError("several inputs make a batch: give --out-dir DIR for their files")
+    folder = Path(os.path.abspath(args.out_dir))
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise CLIError(f"--out-dir '{args.out_dir}' does not exist or is not writable")
+    template = args.out or BATCH_NAME
+    if os.path.dirname(template):
+        raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
+    if INPUT_TOKEN not in template and OBJECT_TOKEN not in template and len(args.input) > 1:
+        raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
+    from .gpu.shaders import cached_shader_count
+    subs = []
+    for path in args.input:
+        sub = argparse.Namespace(**vars(args))
+        sub.out = str(folder / template)
+        fill_input_token(sub, path)
+        sub.input = path
+        subs.append(sub)
+    # Every input's files at once, before any bake: two inputs named alike in different folders
+    # ('a/x.obj', 'b/x.obj') would write one file. Names from {object} are checked per input,
+    # against what the inputs before it wrote (batch_outputs).
+    reads = [(os.path.abspath(path), f"input '{path}'") for path in args.input]
+    planned = [(args.json or "", REPORT)]
+    for sub in subs:
+        planned += [(p, f"{what} of input '{sub.input}'") for p, what in image_outputs(sub, to_colors(sub))
+                    + [(sub.gltf_out or "", GLTF_OUT)] if not has_token(p)]
+    check_output_files(planned, reads)
+    lines, written = [], []
+    for index, sub in enumerate(subs):
+        path = sub.input
+        progress.share(index, len(subs))
+        one = Report(command="bake", input=str(path), hao=report.hao, blender=report.blender)
+        started, shaders = time.perf_counter(), cached_shader_count()
+        sub.batch_inputs = [entry for entry in reads if entry[1] != f"input '{path}'"]
+        sub.batch_outputs = list(written)
+        try:
+            lines += run_bake(sub, one, progress)
+            one.mark_done()
+        except (KeyboardInterrupt, Terminated):
+            raise
+        except BaseException as exc:  # noqa: BLE001 - one input's failure is its line, the batch goes on
+            code, message = failure(exc, None)
+            one.status, one.exit_code, one.error = "error", code, message
+            report.input_errors.append(f"{path}: {message}")
+        one.timings["total"] = round(time.perf_counter() - started, 4)
+        one.shaders_compiled = cached_shader_count() - shaders
+        report.inputs.append(one.as_dict())
+        report.outputs.extend(one.outputs)
+        written += [(out, f"an output of input '{path}'") for out in one.outputs]
+        report.warnings.extend(f"{path}: {w}" for w in one.warnings)
+    return lines

@@ -1,0 +1,191 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The command line's Blender side: input checks and loading, picking meshes, writing mesh files."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .cli_errors import CLIError, last_line
+from .cli_io import check_signals
+from .cli_parser import INPUT_FORMATS
+
+
+def check_input(path: Path, allowed: tuple[str, ...]) -> Path:
+    if not path.exists():
+        raise CLIError(f"input file not found: {path}")
+    if path.is_dir():
+        raise CLIError(f"input '{path}' is a folder, not a file")
+    if path.suffix.lower() not in allowed:
+        raise CLIError(f"unsupported input '{path.suffix}': use {', '.join(allowed)}")
+    if not os.access(path, os.R_OK):
+        raise CLIError(f"cannot read '{path}': permission denied")
+    if path.stat().st_size == 0:
+        raise CLIError(f"input '{path}' is empty")
+    return path.resolve()
+
+
+def check_json_target(spec: str | None) -> None:
+    if spec in (None, "-"):
+        return
+    folder = Path(os.path.abspath(spec)).parent
+    if not folder.is_dir():
+        raise CLIError(f"cannot write the report '{spec}': folder does not exist")
+    if Path(spec).is_dir() or not os.access(folder, os.W_OK):
+        raise CLIError(f"cannot write the report '{spec}'")
+
+
+def load_scene(path: Path) -> None:
+    """Replace the current Blender session with the input file's content."""
+    import bpy
+
+    ext = path.suffix.lower()
+    try:
+        if ext == ".blend":
+            bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+            return
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        check_signals()  # it registers the bundled add-ons: one interrupted there is missing
+        if ext == ".obj":
+            bpy.ops.wm.obj_import(filepath=str(path))
+        else:
+            bpy.ops.import_scene.gltf(filepath=str(path))
+    except (RuntimeError, ValueError, KeyError, OSError, UnicodeError) as exc:  # the importers' own errors
+        check_signals()  # a Python importer interrupted by Ctrl-C fails with Blender's RuntimeError
+        raise CLIError(f"cannot read '{path.name}': {last_line(exc)}") from None
+
+
+def import_meshes(path: Path) -> list:
+    """Add the meshes of a .obj/.glb/.gltf/.blend file to the current scene; returns them."""
+    import bpy
+
+    before = set(bpy.data.objects)
+    try:
+        ext = path.suffix.lower()
+        if ext == ".blend":
+            with bpy.data.libraries.load(str(path)) as (data_from, data_to):
+                data_to.objects = list(data_from.objects)
+            for obj in data_to.objects:
+                if obj is not None and obj.type == 'MESH':
+                    bpy.context.scene.collection.objects.link(obj)
+        elif ext == ".obj":
+            bpy.ops.wm.obj_import(filepath=str(path))
+        else:
+            bpy.ops.import_scene.gltf(filepath=str(path))
+    except (RuntimeError, ValueError, KeyError, OSError, UnicodeError) as exc:
+        check_signals()
+        raise CLIError(f"cannot read '{path.name}': {last_line(exc)}") from None
+    check_signals()
+    meshes = [o for o in bpy.data.objects if o not in before and o.type == 'MESH']
+    if not meshes:
+        raise CLIError(f"--high-poly '{path.name}' holds no mesh")
+    return meshes
+
+
+def pick_high_poly(specs: list[str]) -> list:
+    """The Selected-to-Active sources: each spec a mesh file to add, or a mesh's name."""
+    import bpy
+
+    out = []
+    for spec in specs:
+        path = Path(spec)
+        if path.suffix.lower() in INPUT_FORMATS and bpy.data.objects.get(spec) is None:
+            try:
+                checked = check_input(path, INPUT_FORMATS)
+            except CLIError as exc:
+                raise CLIError(f"--high-poly: {exc}") from None
+            out += import_meshes(checked)
+            continue
+        obj = bpy.data.objects.get(spec)
+        if obj is None or obj.type != 'MESH':
+            raise CLIError(f"--high-poly '{spec}' is neither a mesh file nor a mesh in the input "
+                           f"(meshes: {_mesh_names()})")
+        out.append(obj)
+    return out
+
+
+def pick_mesh(name: str, option: str):
+    import bpy
+
+    obj = bpy.data.objects.get(name)
+    if obj is None or obj.type != 'MESH':
+        raise CLIError(f"{option}: no mesh object named '{name}' (meshes: {_mesh_names()})")
+    return obj
+
+
+def _mesh_names() -> str:
+    """The scene's mesh objects, for messages that name a missing one."""
+    import bpy
+
+    return ", ".join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH') or "none"
+
+
+# The files a colour-attribute bake saves its mesh to (--target color-attribute --out FILE).
+MESH_OUT_FORMATS = (".blend", ".glb", ".ply")
+
+
+def check_mesh_target(path: str, source: Path, allowed: tuple[str, ...], option: str) -> Path:
+    """A mesh file to write (--gltf-out, or --out of a colour-attribute bake), refused before
+    any work unless its extension is allowed, its folder writable and it is not the input."""
+    out = Path(os.path.abspath(path))
+    if out.suffix.lower() not in allowed:
+        raise CLIError(f"{option} must be a {' or '.join(allowed)} file (one file, written atomically), got '{path}'")
+    if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
+        raise CLIError(f"cannot write '{out}': its folder does not exist or is not writable")
+    if out.exists() and out.resolve() == source.resolve():
+        raise CLIError(f"{option} '{out}' is the input file")
+    return out
+
+
+def check_gltf_target(path: str, source: Path) -> Path:
+    """The --gltf-out file: a .glb (check_mesh_target)."""
+    return check_mesh_target(path, source, (".glb",), "--gltf-out")
+
+
+def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
+    """Write the objects alone as a .glb (Blender's glTF exporter; colors: with their active
+    colour attribute as COLOR_0) or a .ply (linear vertex colours when colors), or the whole
+    session as a .blend copy; atomically (a temporary file in the same folder, renamed over
+    path)."""
+    import bpy
+
+    for other in bpy.context.view_layer.objects:
+        other.select_set(other in objects)
+    bpy.context.view_layer.objects.active = objects[0]
+    obj = objects[0]
+    suffix = path.suffix.lower()
+    tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}{suffix}")
+    try:
+        if suffix == ".glb":
+            extra = {"export_vertex_color": 'ACTIVE'} if colors else {}
+            result = bpy.ops.export_scene.gltf(filepath=str(tmp), export_format='GLB', use_selection=True, **extra)
+        elif suffix == ".ply":
+            result = bpy.ops.wm.ply_export(filepath=str(tmp), export_selected_objects=True,
+                                           export_colors='LINEAR' if colors else 'NONE')
+        else:
+            result = bpy.ops.wm.save_as_mainfile(filepath=str(tmp), copy=True, check_existing=False)
+        if result != {'FINISHED'} or not tmp.is_file():
+            raise CLIError(f"writing '{obj.name}' to {path.name} failed")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def export_glb(objects: list, path: Path) -> None:
+    """Write the objects alone as a .glb with their baked maps (export_mesh_file)."""
+    export_mesh_file(objects, path)
+
+
+def pick_target(name: str, exclude: tuple = ()):
+    """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
+    import bpy
+
+    if name:
+        obj = bpy.data.objects.get(name)
+        if obj is None or obj.type != 'MESH':
+            raise CLIError(f"no mesh object named '{name}' (meshes: {_mesh_names()})")
+        return obj
+    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
+    if not meshes:
+        raise CLIError("the input contains no mesh object")
+    return max(meshes, key=lambda o: len(o.data.polygons))
