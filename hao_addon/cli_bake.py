@@ -31,9 +31,11 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     from .blender.color_attributes import AO_ATTRIBUTE
     from .blender.paths import example_path, frame_pattern
     from .core.imageio import check_writable
+    from .core.bake.job_options import JobOptions
     from .core.bake.settings import BakeSettings
 
     settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
+    options = validated(settings_from_args(args, JobOptions), JobOptions)
     source = check_input(Path(args.input), INPUT_FORMATS)
     frames = parse_frames(args.frames) if args.frames else None
     first_frame = frames[0] if frames else 0
@@ -83,15 +85,12 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     if high_poly is not None:
         report.settings["high_poly"] = [o.name for o in high_poly]
         report.settings["cage"] = cage.name if cage else ""
-    request = BakeRequest(targets=targets, settings=settings, texture_set=args.texture_set,
-                          frames=frames,
-                          occluders="VISIBLE" if args.occluders == "visible" else "TARGET",
+    request = BakeRequest(targets=targets, settings=settings, options=options, frames=frames,
                           uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                           filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
                           source_path=str(source),
                           high_poly=high_poly, cage=cage,
                           bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
-                          bent_space=args.bent_space, bent_convention=args.bent_convention,
                           wire_material=gltf_out is not None,
                           extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
                           extra_outputs=writes, claimed=list(getattr(args, "batch_outputs", [])),

@@ -11,7 +11,6 @@ from . import __version__
 from .cli_errors import CLIError
 from .cli_io import ProcessOutput
 from .cli_options import add_setting_options
-from .core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 
 
 # A batch's file names in --out-dir, unless --out gives them ({input}: the input's name without
@@ -65,6 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
 def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     """What a bake takes (bake, and the farm commands that write bake jobs): inputs, outputs,
     frames and every bake setting."""
+    from .core.bake.job_options import JobOptions
     from .core.bake.settings import BakeSettings
 
     b.add_argument("input", nargs="*", help=".obj, .glb/.gltf or .blend file; several make a batch (--out-dir)")
@@ -92,12 +92,6 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--object", action="append", default=None, metavar="NAME",
                    help="mesh to bake (default: the mesh with the most faces); repeatable: each into its own "
                         "file ({object} in --out, else _NAME is added), or with --texture-set all into one")
-    b.add_argument("--texture-set", action="store_true",
-                   help="bake the --object meshes together into one shared image (their UV islands must not "
-                        "overlap across objects); {object} in file names becomes 'TextureSet'")
-    b.add_argument("--occluders", choices=("target", "visible"), default="visible",
-                   help="target: self-occlusion only (with --high-poly: the high-poly only); visible: every "
-                        "visible mesh occludes (default)")
     b.add_argument("--high-poly", action="append", default=None, metavar="PATH_OR_NAME",
                    help="Selected to Active: bake this high-poly onto the low-poly's UVs (repeatable): a "
                         ".obj/.glb/.gltf/.blend file whose meshes are the sources, or the name of a mesh in INPUT; "
@@ -111,9 +105,7 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--gltf-out", default="", metavar="FILE.glb",
                    help="also write the baked object as a .glb with the map as its material's occlusionTexture "
                         "(Blender's glTF exporter; the map on the UV map that was baked)")
-    for option, choices in (("--bent-space", SPACE_CHOICES), ("--bent-convention", CONVENTION_CHOICES)):
-        b.add_argument(option, choices=[c.value for c in choices], default=choices[0].value,
-                       help="; ".join(f"{c.value}: {c.description}" for c in choices) + f" (default {choices[0].value})")
+    add_setting_options(b, JobOptions)  # --occluders, --texture-set, --bent-space, --bent-convention
 
 
 def add_run_options(p: argparse.ArgumentParser) -> None:

@@ -1,25 +1,22 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Per-scene bake settings (Scene.hao_bake), saved with the .blend file."""
 
+from dataclasses import replace
+
 import bpy
 from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringProperty
 
 from ..hao_addon import compat
 from ..hao_addon.blender.bake_job import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
-from ..hao_addon.core.bake.tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
-from .setting_props import enum_items, setting_annotations, settings_from
+from ..hao_addon.core.bake.job_options import JobOptions
+from .setting_props import setting_annotations, settings_from
 
 
 class HAO_PG_bake_settings(bpy.types.PropertyGroup):
-    # What the bake computes comes from BakeSettings (setting_annotations, below); these say
-    # which objects, UV map and outputs the Blender job uses.
-    occluders: EnumProperty(
-        name="Occluders", description="What casts occlusion onto the baked mesh",
-        items=(('TARGET', "Self", "Only the baked mesh itself"),
-               ('SELECTED', "Selected", "The baked mesh and the other selected meshes"),
-               ('VISIBLE', "Visible", "Every visible mesh in the view layer")),
-        default='SELECTED')
+    # What the bake computes comes from BakeSettings, which meshes occlude and how outputs are
+    # laid out from JobOptions (setting_annotations, below); these say which objects, UV map
+    # and outputs the Blender job uses.
     uv_mode: EnumProperty(
         name="UV Map", description="Which UV map the AO is baked into",
         items=(('AUTO', "Auto", "AO_UV if present, else the first UV map, else a new AO_UV map unwrapped with xatlas"),
@@ -43,23 +40,10 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Cage Object", type=bpy.types.Object, poll=lambda _self, obj: obj.type == 'MESH',
         description="Selected to Active: rays start on this copy of the active mesh (same topology, moved "
                     "vertices) instead of the cage extrusion")
-    bent_space: EnumProperty(
-        name="Space", description="The space the bent normals are written in",
-        items=enum_items(SPACE_CHOICES),
-        default=SPACE_CHOICES[0].value)
-    bent_convention: EnumProperty(
-        name="Convention", description="Which way the green channel points",
-        items=enum_items(CONVENTION_CHOICES),
-        default=CONVENTION_CHOICES[0].value)
     bent_filepath: StringProperty(
         name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "
                                                  "{object} is replaced by the object's name", default="",
         subtype='FILE_PATH', options=compat.path_property_options())
-    texture_set: BoolProperty(
-        name="Texture Set",
-        description="Bake the selected meshes together into one shared image 'TextureSet_AO', each on its own UVs "
-                    "(islands must not overlap across objects); each occludes the others",
-        default=False)
     frame_range: BoolProperty(
         name="Frame Range",
         description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
@@ -85,13 +69,13 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
             targets = [active] if active is not None else []
         settings = self.to_settings()
         to_image = settings.target == "image"  # a colour attribute ignores the image outputs
-        return BakeRequest(targets=targets, settings=settings, occluders=self.occluders, uv_map=uv,
+        options = settings_from(self, JobOptions)
+        options = replace(options, texture_set=options.texture_set and to_image and not self.selected_to_active)
+        return BakeRequest(targets=targets, settings=settings, options=options, uv_map=uv,
                            image=self.image if to_image else None, filepath=self.filepath if to_image else "",
                            wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
-                           bent_space=self.bent_space, bent_convention=self.bent_convention,
-                           texture_set=self.texture_set and to_image and not self.selected_to_active,
                            frames=self.scene_frames() if self.frame_range else None)
 
     def scene_frames(self) -> list[int]:
@@ -101,6 +85,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
 
 
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))
+HAO_PG_bake_settings.__annotations__.update(setting_annotations(JobOptions))
 
 
 def register() -> None:

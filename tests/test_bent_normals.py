@@ -101,16 +101,14 @@ def test_gather_matches_the_reference_on_the_rocker_arm(gpu_context):
     assert mask.sum() > 1000 and rmse <= 3.0, (rmse, int(mask.sum()))
 
 
-def _bent_job(scene, obj, occluders="VISIBLE", **request):
+def _bent_job(scene, obj, occluders="visible", **options):
     import bpy
     from conftest import small_settings
     from hao_addon.blender.bake_job import BakeJob
 
-    settings = small_settings(scene, method='gather', directions=128, bent_normals=True, occluders=occluders)
-    req = settings.to_request([obj])
-    for k, v in request.items():
-        setattr(req, k, v)
-    job = BakeJob(req, bpy.context.evaluated_depsgraph_get)
+    settings = small_settings(scene, method='gather', directions=128, bent_normals=True, occluders=occluders,
+                              **options)
+    job = BakeJob(settings.to_request([obj]), bpy.context.evaluated_depsgraph_get)
     job.run()
     return job
 

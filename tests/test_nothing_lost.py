@@ -22,6 +22,7 @@ from hao_addon.bake import clear_cache
 from hao_addon.blender import images, mesh_data
 from hao_addon.blender.bake_job import BakeJob, BakeRequest
 from hao_addon.blender.color_attributes import AO_ATTRIBUTE
+from hao_addon.core.bake.job_options import JobOptions
 from hao_addon.core.bake.settings import BakeSettings
 
 SPOT = ROOT / "samples" / "spot.obj"
@@ -264,7 +265,7 @@ def test_tangent_bent_normals_of_n_gons_from_a_triangulated_copy(gpu_context, tm
     np.testing.assert_allclose(tangent[quads], expected, atol=1e-6)
     job = BakeJob(BakeRequest([obj], BakeSettings(size=64, directions=8, bent_normals=True),
                               filepath=str(tmp_path / "ao.png"), bent_filepath=str(tmp_path / "bent.png"),
-                              bent_space="tangent"), bpy.context.evaluated_depsgraph_get)
+                              options=JobOptions(bent_space="tangent")), bpy.context.evaluated_depsgraph_get)
     job.run()
     job.commit()
     assert sorted(os.listdir(tmp_path)) == ["ao.png", "bent.png"]

@@ -216,13 +216,13 @@ def test_selected_occluders_darken_the_floor(scene):
     from hao_addon.blender.images import image_pixels_gray
     floor = soup_to_object(scenes.grid_plane(8.0, 16), "Floor")
     ball = soup_to_object(scenes.uv_sphere(1.0, (0, 0, 1.0), 32, 16), "Ball")
-    small_settings(scene, occluders='TARGET')
+    small_settings(scene, occluders='target')
     select_only(floor)
     bpy.ops.object.hao_bake_ao()
     alone = image_pixels_gray(bpy.data.images["Floor_AO"])
     bpy.data.images.remove(bpy.data.images["Floor_AO"])
     np.testing.assert_allclose(alone, 1.0, atol=1e-5)
-    small_settings(scene, occluders='SELECTED')
+    small_settings(scene, occluders='selected')
     select_only(floor, ball)
     bpy.ops.object.hao_bake_ao()  # bakes both selected meshes, each occluding the other
     shaded = image_pixels_gray(bpy.data.images["Floor_AO"])
@@ -293,7 +293,7 @@ def test_selected_to_active_bakes_the_high_poly_onto_the_active_mesh(scene, capf
     floor = soup_to_object(scenes.grid_plane(200.0, 16), "Floor", uv=False)
     ball = soup_to_object(scenes.uv_sphere(0.5, (0, 0, 0.5), 32, 16), "Ball", uv=False)
     before = uv_array(low.data, "UVMap")
-    small_settings(scene, selected_to_active=True, occluders='SELECTED')
+    small_settings(scene, selected_to_active=True, occluders='selected')
     select_only(low, floor, ball)
     assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
     ao = image_pixels_gray(bpy.data.images["Low_AO"])

@@ -18,10 +18,11 @@ sys.path.insert(0, str(ROOT))
 
 from hao_addon.core.setting_spec import specs  # noqa: E402
 from hao_addon.core.bake import abilities  # noqa: E402
+from hao_addon.core.bake.job_options import JobOptions  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings  # noqa: E402
 
-TABLES = {"bake": (BakeSettings,), "view": (ViewAOSettings,), "render-size": (RenderSize,)}
+TABLES = {"bake": (BakeSettings,), "job": (JobOptions,), "view": (ViewAOSettings,), "render-size": (RenderSize,)}
 
 
 def table(*settings_classes) -> str:
@@ -31,6 +32,8 @@ def table(*settings_classes) -> str:
             option = f"`{spec.option(f.name) or spec.cli_via}`" if spec.option(f.name) or spec.cli_via else "(panel only)"
             label = spec.label if spec.ui else "(command line only)"
             default = f"`{f.default}`" if not isinstance(f.default, bool) else ("on" if f.default else "off")
+            if spec.cli_default is not None:
+                default += f" (command line: `{spec.cli_default}`)"
             what = spec.sentence
             if spec.choices:
                 what += ": " + "; ".join(f"*{c.label}* (`{c.value}`) {c.description}" for c in spec.choices)

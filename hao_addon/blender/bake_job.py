@@ -28,7 +28,8 @@ from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
-from ..core.bake.tangent_space import CONVENTIONS, SPACES, bent_normal_map
+from ..core.bake.job_options import JobOptions
+from ..core.bake.tangent_space import bent_normal_map
 from ..core.bake.texture_set import texture_set_target
 from ..core.bake.udim import tile_path, udim_layout
 from ..core.geometry import face_normals_areas
@@ -37,8 +38,7 @@ from . import color_attributes, images, mesh_data
 from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
-OCCLUDER_MODES = ("TARGET", "SELECTED", "VISIBLE")
-# What a texture set's image and files are named after (BakeRequest.texture_set).
+# What a texture set's image and files are named after (JobOptions.texture_set).
 TEXTURE_SET_NAME = "TextureSet"
 
 
@@ -55,12 +55,12 @@ class BakeRequest:
     target's UVs and occlude, the target does not; cage: an optional cage object (the
     target's topology, moved vertices) the rays start from.
     Bent normals (settings.bent_normals): each target also gets an image '<object>_BentNormals'
-    in bent_space ('tangent': the baked UV map's MikkTSpace; 'object') and bent_convention
-    ('opengl' Y+, 'directx' Y-), saved to bent_filepath if given (tokens as filepath).
+    in options.bent_space and options.bent_convention, saved to bent_filepath if given
+    (tokens as filepath).
     settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
     instead (settings.color_domain), UV map, image and files unused.
-    texture_set: the targets, each with its own UVs (not overlapping across objects), bake
-    together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet').
+    options.texture_set: the targets, each with its own UVs (not overlapping across objects),
+    bake together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet').
     frames: a frame sequence: the scene is set to each frame in turn (restored after), each
     frame's maps go to files ({frame} in the paths, zero-padded; '_{frame}' added otherwise),
     no image datablocks; a frame whose evaluated geometry equals an earlier one reuses its
@@ -68,7 +68,6 @@ class BakeRequest:
 
     targets: list
     settings: BakeSettings
-    occluders: str = "TARGET"
     uv_map: str = "AUTO"
     image: "bpy.types.Image | None" = None
     image_name: str = ""
@@ -78,9 +77,7 @@ class BakeRequest:
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None
     bent_filepath: str = ""
-    bent_space: str = "tangent"
-    bent_convention: str = "opengl"
-    texture_set: bool = False
+    options: JobOptions = field(default_factory=JobOptions)
     frames: list | None = None
     # What else the caller reads and writes, as (path, what) pairs, so that one check
     # (core/output_files.py) sees every file of the run: the CLI's --json report, --gltf-out,
@@ -124,7 +121,7 @@ def output_path_for(request: BakeRequest, obj, filepath: str | None = None, fram
         path = with_token(path, FRAME_TOKEN)
     if frame is not None:
         path = frame_file(path, frame)
-    if request.texture_set:
+    if request.options.texture_set:
         return path.replace(OBJECT_TOKEN, TEXTURE_SET_NAME)
     if len(request.targets) > 1:
         path = with_token(path, OBJECT_TOKEN)
@@ -154,18 +151,15 @@ def validate_request(request: BakeRequest) -> None:
             raise BakeInputError(f"'{obj.name}' has no UV map named '{name}'")
         if name == "" and not obj.data.uv_layers:
             raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto (xatlas) to unwrap it")
-    if request.occluders not in OCCLUDER_MODES:
-        raise BakeInputError(f"occluders must be one of {OCCLUDER_MODES}")
+    request.options.validated()
     if request.frames is not None:
         _validate_frames(request)
-    if request.texture_set:
+    if request.options.texture_set:
         _validate_texture_set(request)
     elif request.image is not None and len(request.targets) > 1:
         raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
     if request.bent_filepath and not request.settings.bent_normals:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
-    if request.bent_space not in SPACES or request.bent_convention not in CONVENTIONS:
-        raise BakeInputError(f"bent normals: space must be one of {SPACES}, convention one of {CONVENTIONS}")
     size = request.settings.size
     for obj in _file_owners(request):
         for _kind, filepath, _what, channels in output_kinds(request):
@@ -188,7 +182,7 @@ def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
 
 def _file_owners(request: BakeRequest) -> list:
     """The targets whose files are written: every target, or a texture set's first (shared)."""
-    return request.targets[:1] if request.texture_set else request.targets
+    return request.targets[:1] if request.options.texture_set else request.targets
 
 
 def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple[str, str]]:
@@ -197,7 +191,7 @@ def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple
     caller's extra_outputs."""
     out = []
     for obj in _file_owners(request):
-        label = TEXTURE_SET_NAME if request.texture_set else obj.name
+        label = TEXTURE_SET_NAME if request.options.texture_set else obj.name
         for _kind, filepath, what, _channels in output_kinds(request):
             if not filepath:
                 continue
@@ -263,7 +257,7 @@ def _validate_texture_set(request: BakeRequest) -> None:
         if obj.type == 'MESH' and not obj.data.uv_layers:
             raise BakeInputError(f"'{obj.name}' has no UV map: a texture set bakes each object's own UVs into one "
                                  f"image, so lay out its islands beside the other objects' first")
-    if request.settings.bent_normals and request.bent_space == "object":
+    if request.settings.bent_normals and request.options.bent_space == "object":
         raise BakeInputError("object-space bent normals of a texture set would mix the objects' spaces: use "
                              "tangent space")
 
@@ -355,10 +349,10 @@ class BakeJob:
         return new_name
 
     def _occluder_objects(self, target) -> list:
-        mode = self.request.occluders
-        if mode == "TARGET":
+        mode = self.request.options.occluders
+        if mode == "target":
             candidates = []
-        elif mode == "SELECTED":
+        elif mode == "selected":
             candidates = [o for o in self.request.targets if o != target]
             candidates += [o for o in bpy.context.selected_objects if o.type == 'MESH' and o not in candidates]
         else:
@@ -416,14 +410,14 @@ class BakeJob:
         progress runs from start over share of the bar."""
         req = self.request
         depsgraph = self._depsgraph_getter()
-        units = [req.targets] if req.texture_set else [[obj] for obj in req.targets]
+        units = [req.targets] if req.options.texture_set else [[obj] for obj in req.targets]
         at = "" if frame is None else f" at frame {frame}"
         for k, objects in enumerate(units):
             obj = objects[0]
-            label = TEXTURE_SET_NAME if req.texture_set else obj.name
+            label = TEXTURE_SET_NAME if req.options.texture_set else obj.name
             parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
                                               shading_normals=req.settings.normals == "mesh") for o in objects]
-            target = texture_set_target(parts, req.settings.size, label) if req.texture_set else parts[0]
+            target = texture_set_target(parts, req.settings.size, label) if req.options.texture_set else parts[0]
             vertex_target = None
             if req.to_color_attribute:
                 vertex_target = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
@@ -470,7 +464,7 @@ class BakeJob:
         req = self.request
         linear = np.array(objects[0].evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
         tangents = normals = None
-        if req.bent_space == "tangent":
+        if req.options.bent_space == "tangent":
             tangents = np.concatenate([mesh_data.corner_tangents(o, depsgraph, uv)
                                        for o, uv in zip(objects, uv_names)])
             # The world corner normals as they are (not re-normalized: on a scaled object that
@@ -480,13 +474,13 @@ class BakeJob:
                 normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
         if result.tiles is None:
             return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin,
-                                   target.uvs, req.bent_space, req.bent_convention, linear, tangents, normals)
+                                   target.uvs, req.options.bent_space, req.options.bent_convention, linear, tangents, normals)
         layout = udim_layout(target.uvs)  # one map per tile, from the tile's own triangles
         maps = []
         for tile in range(layout.count):
             faces, local = layout.local_uvs(target.uvs, tile)
             maps.append(bent_normal_map(result.bent_normals[tile], result.covered[tile], result.filled[tile],
-                                        req.settings.margin, local, req.bent_space, req.bent_convention, linear,
+                                        req.settings.margin, local, req.options.bent_space, req.options.bent_convention, linear,
                                         None if tangents is None else tangents[faces],
                                         None if normals is None else normals[faces]))
         return np.stack(maps)
@@ -608,7 +602,7 @@ class BakeJob:
 
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""
-        return TEXTURE_SET_NAME if self.request.texture_set else obj.name
+        return TEXTURE_SET_NAME if self.request.options.texture_set else obj.name
 
     def baked(self, results: list | None = None) -> list:
         """(first object, label, result) of each bake of results (default self.results, the

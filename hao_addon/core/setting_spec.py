@@ -42,6 +42,7 @@ class Spec:
     subtype: str = ""
     cli: str | None = ""
     cli_via: str = ""
+    cli_default: Any = None
     ui: bool = True
 
     @property
