@@ -24,6 +24,8 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
+from ..core.errors import BakeInputError
+from ..core.bake.estimators import AMBIENT_OCCLUSION
 from ..core.bake.plan import BakePlan
 from . import util
 from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
@@ -79,6 +81,16 @@ class ScatterBaker(LightViewBaker):
     """Owns the accumulator and the light-view targets of one bake."""
 
     METHOD = "scatter"
+
+    @classmethod
+    def check_limits(cls, plan: BakePlan) -> None:
+        """Also refuse an estimator its accumulator cannot hold, declared or not: it packs
+        (numerator, denominator) with numerator <= denominator in one word
+        (gpu_shaders/bake_common.glsl), the ambient-occlusion estimator's sums only."""
+        super().check_limits(plan)
+        if plan.estimator is not AMBIENT_OCCLUSION:
+            raise BakeInputError(f"the histogram scatter bakes ambient occlusion only, not {plan.estimator.name}; "
+                                 f"use the gather (Shadow-Map Gather) or the reference")
 
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:
