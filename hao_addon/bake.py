@@ -24,6 +24,8 @@ from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
 from .core.bake.seams import element_values, finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
+from .core.bake.abilities import choose_method
+from .core.bake.targets import BakeTarget, as_bake_target
 from .core.bake.vertex_target import VertexTarget
 
 
@@ -53,11 +55,13 @@ _CACHE: "OrderedDict[str, BakeResult]" = OrderedDict()
 _CACHE_SIZE = 8
 
 
-def bake_key(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+def bake_key(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
              high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> str:
     """A digest of everything a bake's result depends on (geometry, UVs, normals, settings):
     equal keys bake equal maps. The cache's key, and a frame sequence's test for a frame
     that repeats an earlier one."""
+    bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
+    target, high_to_low, vertex_target = bake_target.soup, bake_target.high_to_low, bake_target.corners
     h = hashlib.blake2b(digest_size=20)
     h.update(repr(settings.cache_key()).encode())
     if vertex_target is not None:
@@ -90,18 +94,20 @@ def clear_cache() -> None:
     _CACHE.clear()
 
 
-def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                use_cache: bool = True, high_to_low: HighToLow | None = None,
                vertex_target: VertexTarget | None = None) -> Generator[float, None, BakeResult]:
     """Bake `target` (with UVs) against itself and `occluders`; yields progress in [0, 1].
     With `high_to_low`, bake its sources onto the target's UVs (Selected to Active); with
     settings.target 'color-attribute', at the face corners of `vertex_target` (no UVs).
+    target may be a BakeTarget (core/bake/targets.py) that holds either itself.
 
     A re-bake of identical geometry, UVs and settings returns the cached result at once
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
     """
     t0 = time.perf_counter()
-    key = bake_key(target, occluders, settings, high_to_low, vertex_target) if use_cache else None
+    target = as_bake_target(target, settings.target, high_to_low, vertex_target)
+    key = bake_key(target, occluders, settings) if use_cache else None
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
@@ -111,7 +117,7 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
         return BakeResult(cached.ao, cached.covered, cached.filled, stats, cached.bent_normals, cached.tiles)
     # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
     with single_threaded_blas() as blas_threads:
-        result = yield from _bake_uncached(target, occluders, settings, high_to_low, vertex_target)
+        result = yield from _bake_uncached(target, occluders, settings)
     result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
                         target_name=target.name)
     if key is not None:
@@ -121,17 +127,17 @@ def bake_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: Ba
     return result
 
 
-def _bake_uncached(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
-                   high_to_low: HighToLow | None, vertex_target: VertexTarget | None
+def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings
                    ) -> Generator[float, None, BakeResult]:
     """bake_steps without its cache: plan, run the baker's directions, finish the output."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
-    method = settings.method_for(high_to_low is not None)
-    share = PROJECTION_PROGRESS_SHARE if high_to_low is not None else 0.0
+    projects = target.high_to_low is not None
+    method = settings.method_for(projects)
+    share = PROJECTION_PROGRESS_SHARE if projects else 0.0
     # The method's own ray cast (an unknown method is refused by the plan's validation).
-    cast = ray_caster_for(method) if high_to_low is not None and method in BAKE_METHODS else None
+    cast = ray_caster_for(method) if projects and method in BAKE_METHODS else None
     cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
-    planning = make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target)
+    planning = make_plan_steps(target, occluders, settings, cast=cast)
     try:
         while True:
             try:
@@ -142,7 +148,7 @@ def _bake_uncached(target: TriangleSoup, occluders: list[TriangleSoup], settings
             yield share * fraction
     finally:
         planning.close()  # cancelled during the projection: stop it there
-    method = settings.method_for(high_to_low is not None, tiled=plan.udim is not None)
+    method = choose_method(settings.method, plan.abilities_needed)
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
@@ -176,7 +182,7 @@ def _bake_uncached(target: TriangleSoup, occluders: list[TriangleSoup], settings
     return BakeResult(ao, covered, filled, stats, bent, tile_numbers)
 
 
-def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
          progress: Callable[[float], None] | None = None, use_cache: bool = True,
          high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> BakeResult:
     """Blocking bake (drains bake_steps)."""
@@ -193,5 +199,5 @@ def bake(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSett
         steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
 
 
-__all__ = ["BakeInputError", "BakeResult", "HighToLow", "VertexTarget", "bake", "bake_key", "bake_steps",
+__all__ = ["BakeInputError", "BakeResult", "BakeTarget", "HighToLow", "VertexTarget", "bake", "bake_key", "bake_steps",
            "clear_cache"]

@@ -30,9 +30,10 @@ from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.job_options import JobOptions
 from ..core.bake.tangent_space import bent_normal_map
+from ..core.bake.targets import BakeTarget
 from ..core.bake.texture_set import texture_set_target
 from ..core.bake.udim import tile_path, udim_layout
-from ..core.geometry import face_normals_areas
+from ..core.geometry import TriangleSoup, face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
 from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
@@ -417,18 +418,19 @@ class BakeJob:
             label = TEXTURE_SET_NAME if req.options.texture_set else obj.name
             parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
                                               shading_normals=req.settings.normals == "mesh") for o in objects]
-            target = texture_set_target(parts, req.settings.size, label) if req.options.texture_set else parts[0]
-            vertex_target = None
+            soup = texture_set_target(parts, req.settings.size, label) if req.options.texture_set else parts[0]
+            corners = None
             if req.to_color_attribute:
-                vertex_target = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
+                corners = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
             high_to_low = self._high_to_low(obj, depsgraph) if req.high_poly is not None else None
+            target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
             skip = set(req.high_poly or ()) | {req.cage} | set(objects)
             occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
                          for o in self._occluder_objects(obj) if o not in skip]
             settings = terminator_settings(req.settings, req.high_poly or objects)
             key = None
             if frame is not None:
-                key = (label, bake_key(target, occluders, settings, high_to_low, vertex_target))
+                key = (label, bake_key(target, occluders, settings))
                 if key in self._frame_bakes:  # the geometry of an earlier frame: its files are copied
                     earlier, stats, tiles = self._frame_bakes[key]
                     self._copies[label] = earlier
@@ -437,8 +439,7 @@ class BakeJob:
                     yield start + share * (k + 1) / len(units), f"Reusing frame {earlier} for '{label}'{at}"
                     continue
             # A sequence bakes past the shared cache: it would hold up to its size in maps.
-            gen = bake_steps(target, occluders, settings, use_cache=frame is None, high_to_low=high_to_low,
-                             vertex_target=vertex_target)
+            gen = bake_steps(target, occluders, settings, use_cache=frame is None)
             try:
                 while True:
                     try:
@@ -452,13 +453,14 @@ class BakeJob:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
             if settings.bent_normals:
                 self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
-                                                           target, result)
+                                                           soup, result)
             # A texture set's objects share one result (commit writes it once).
             self.results.extend((o, uv_names[o.name], result) for o in objects)
             if key is not None:
                 self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
 
-    def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target, result: BakeResult):
+    def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target: TriangleSoup,
+                    result: BakeResult):
         """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
         texture set's, whose target is their soups in that order), in the request's space."""
         req = self.request

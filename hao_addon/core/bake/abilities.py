@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Mapping
 
 from ..errors import BakeInputError
+from .target_kinds import TargetKind
 
 
 @dataclass(frozen=True)
@@ -87,12 +88,13 @@ def bakers_with(*abilities: str, gpu_only: bool = False) -> list[str]:
     return [b.method for b in BAKERS if b.can_all(frozenset(abilities)) and (b.gpu or not gpu_only)]
 
 
-def abilities_needed(max_distance: float, high_to_low: bool, bent_normals: bool, target: str,
+def abilities_needed(max_distance: float, bent_normals: bool, target_kind: TargetKind,
                      tiled: bool) -> frozenset[str]:
-    """The abilities a bake with these settings and inputs needs."""
-    asked = {"max-distance": max_distance > 0.0, "selected-to-active": high_to_low, "bent-normals": bent_normals,
-             "udim": tiled, "color-attribute": target == "color-attribute"}
-    return frozenset(name for name, needed in asked.items() if needed)
+    """The abilities a bake with these settings, this kind of target (its row's ability:
+    Selected to Active, a colour attribute) and, where tiled, a UV layout on UDIM tiles needs."""
+    asked = {"max-distance": max_distance > 0.0, "bent-normals": bent_normals, "udim": tiled}
+    needed = {name for name, wanted in asked.items() if wanted}
+    return frozenset(needed | ({target_kind.ability} if target_kind.ability else set()))
 
 
 def choose_method(method: str, needs: frozenset[str]) -> str:

@@ -16,7 +16,7 @@ from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
-from .abilities import check_method
+from .abilities import abilities_needed, check_method, choose_method
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
@@ -24,6 +24,8 @@ from .receivers import Receivers, corner_receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings
 from .udim import UdimLayout, udim_layout
+from .target_kinds import TARGET_KINDS, TargetKind
+from .targets import BakeTarget, as_bake_target
 from .vertex_target import VertexTarget
 from .views import OrthoView, cell_corners, fit_views
 
@@ -85,6 +87,8 @@ class BakePlan:
     # The UDIM tiles of a tiled UV layout (core/bake/udim.py): one map per tile.
     udim: UdimLayout | None = None
     stats: dict = field(default_factory=dict)
+    # The target's kind (core/bake/target_kinds.py): texels, corners or projected points.
+    kind: TargetKind = TARGET_KINDS["texels"]
 
     def receivers(self) -> Receivers:
         """The bake's receivers: the projected high-poly points, the target's face corners
@@ -111,7 +115,7 @@ class BakePlan:
     @property
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
-        return self.settings.abilities_needed(self.projected is not None, tiled=self.udim is not None)
+        return abilities_needed(self.settings.max_distance, self.settings.bent_normals, self.kind, self.udim is not None)
 
     def check_method(self, method: str) -> None:
         """Refuse `method` if it cannot bake this plan (core/bake/abilities.py)."""
@@ -131,8 +135,8 @@ class BakePlan:
 
     @property
     def target_drawn(self) -> bool:
-        """Whether the target occludes (not in Selected to Active, as in Cycles)."""
-        return self.projected is None
+        """Whether the target occludes (its kind's row: not in Selected to Active, as in Cycles)."""
+        return self.kind.target_occludes
 
     @property
     def drawn_positions(self) -> np.ndarray:
@@ -206,41 +210,29 @@ def _check_finite(soup: TriangleSoup) -> None:
         raise BakeInputError(f"'{soup.name}' has NaN or infinite UV coordinates")
 
 
-def make_plan(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+def make_plan(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
               high_to_low: HighToLow | None = None, cast: RayCast | None = None,
               vertex_target: VertexTarget | None = None) -> BakePlan:
     """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
     with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
     and the occluders occlude, the target does not), its rays cast by `cast` (default the
     CPU's, projection.project_steps); or, with `vertex_target` (settings.target
-    'color-attribute'), at its face corners, UVs not needed."""
+    'color-attribute'), at its face corners, UVs not needed. target may be a BakeTarget
+    (core/bake/targets.py) instead, which holds high_to_low or vertex_target itself."""
     return drain(make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target))
 
 
-def _check_target(target: TriangleSoup, settings: BakeSettings, high_to_low: HighToLow | None,
-                  vertex_target: VertexTarget | None) -> None:
-    if target.face_count == 0:
-        raise BakeInputError(f"'{target.name}' has no faces to bake")
-    if settings.target == "color-attribute":
-        if vertex_target is None or vertex_target.cells.shape != (target.face_count, 3):
-            raise BakeInputError(f"'{target.name}': a colour-attribute bake needs the mesh's vertices and corners")
-        if high_to_low is not None or settings.bent_normals:
-            raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active and "
-                                 "bent normals bake into images (Target: Image Textures)")
-    elif target.uvs is None:
-        raise BakeInputError(f"'{target.name}' has no UV map")
-    _check_finite(target)
-
-
-def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                     high_to_low: HighToLow | None = None, cast: RayCast | None = None,
                     vertex_target: VertexTarget | None = None) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled."""
     settings = settings.validated()
-    _check_target(target, settings, high_to_low, vertex_target)
-    if settings.target != "color-attribute":
-        vertex_target = None
+    bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
+    bake_target.check(settings.bent_normals)
+    kind, target = bake_target.kind, bake_target.soup
+    high_to_low, vertex_target = bake_target.high_to_low, bake_target.corners
+    _check_finite(target)
     for occ in occluders:
         _check_finite(occ)
     if high_to_low is not None:
@@ -251,7 +243,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     if not (areas > 0.0).any():
         raise BakeInputError(f"'{target.name}' has only zero-area faces")
     udim = None
-    if vertex_target is None:
+    if kind.needs_uvs:
         uv_area = uv_areas(target.uvs)
         if not (uv_area > 0.0).any():
             raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
@@ -260,8 +252,8 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
     else:  # no UV layout: the light views are as fine as for a Size map over the bounding sphere
         uv_area, uv_warnings, uv_counters = None, [], {}
     # A method that cannot bake what is asked is refused before the projection's rays.
-    needs = settings.abilities_needed(high_to_low is not None, tiled=udim is not None)
-    check_method(settings.method_for(high_to_low is not None, tiled=udim is not None), needs, asked_phrases(udim))
+    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None)
+    check_method(choose_method(settings.method, needs), needs, asked_phrases(udim))
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
@@ -313,15 +305,14 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
                  if ((areas[faces] > 0.0) & (uv_area[faces] > 0.0)).any()]  # a tile of zero-area faces asks nothing
         pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
         dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
-    elif vertex_target is None:
-        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale,
-                                                    settings.method_for(high_to_low is not None))
+    elif kind.needs_uvs:
+        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale, choose_method(settings.method, needs))
     else:  # Size pixels across the bounding sphere's diameter (2), times sqrt(view samples)
         pixel_size, dense_fraction = 2.0 / (settings.size * float(np.sqrt(settings.view_samples))), 0.0
     # The receivers' sphere has diameter 2 (the target's), or 2 extent in Selected to Active.
     pixel_size = max(pixel_size, 2.0 * extent / (MAX_VIEW_SIDE - 4))
 
-    drawn_parts = [o_pos.reshape(-1, 3)] if projected is not None else [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)]
+    drawn_parts = [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)] if kind.target_occludes else [o_pos.reshape(-1, 3)]
     drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
@@ -356,7 +347,7 @@ def make_plan_steps(target: TriangleSoup, occluders: list[TriangleSoup], setting
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, vertex_target, udim, stats)
+                    closed, holes, projected, vertex_target, udim, stats, kind)
 
 
 def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:

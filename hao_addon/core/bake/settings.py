@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
 from .abilities import abilities_needed, choose_method
+from .target_kinds import TARGET_KINDS, kind_name
 
 MAX_DIRECTIONS = 65536
 MAX_MAP_SIZE = 16384
@@ -142,7 +143,8 @@ class BakeSettings:
 
     def abilities_needed(self, high_to_low: bool, tiled: bool = False) -> frozenset[str]:
         """What a baker must be able to bake for these settings (core/bake/abilities.py)."""
-        return abilities_needed(self.max_distance, high_to_low, self.bent_normals, self.target, tiled)
+        kind = TARGET_KINDS[kind_name(self.target, high_to_low)]
+        return abilities_needed(self.max_distance, self.bent_normals, kind, tiled)
 
     @property
     def sample_count(self) -> int:
