@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import asdict, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from .cli_errors import CLIError
@@ -21,18 +21,62 @@ from .core.setting_spec import SettingError
 GLTF_OUT = "the glTF file (--gltf-out)"  # its name in collision messages
 
 
+@dataclass
+class _Run:
+    """One input's bake as checked before anything is loaded."""
+
+    settings: object  # BakeSettings
+    options: object   # JobOptions
+    source: Path
+    frames: list[int] | None
+    gltf_out: Path | None
+    mesh_out: Path | None  # a colour bake's mesh file
+    reads: list[tuple[str, str]]
+    writes: list[tuple[str, str]]
+    key: str  # the run's bake key (cli_skip.run_key)
+
+    @property
+    def to_colors(self) -> bool:
+        return self.settings.target == "color-attribute"
+
+
 def run_bake(args, report: Report, progress: Progress) -> list[str]:
-    """Bake; returns the summary lines to print."""
+    """Bake one input (args.input): check every file, load, pick the meshes, bake, write all
+    or nothing; returns the summary lines to print."""
     import bpy
 
-    from .blender.bake_job import BakeJob, BakeRequest, output_path_for
-    from .cli_skip import run_key, skip_finished
-    from .core.imageio import BAKE_KEY
-    from .blender.color_attributes import AO_ATTRIBUTE
-    from .blender.paths import example_path, frame_pattern
-    from .core.imageio import check_writable
+    from .blender.bake_job import BakeJob
+
+    run = _checked_run(args, report)
+    with report.phase("load"):
+        progress.update("loading")
+        load_scene(run.source)
+    check_signals()
+    targets, high_poly, cage = _pick_objects(args, report)
+    request = _request(args, run, targets, high_poly, cage)
+    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
+    skip_lines = []
+    if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
+        from .cli_skip import skip_finished
+        left, skip_lines = skip_finished(request, run.key, report)
+        if left is None:
+            return skip_lines
+        if left is not request:  # the frames still missing
+            request = left
+            job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
+    start_gpu()
+    t0 = time.perf_counter()
+    _bake_and_write(job, run, targets, report, progress)
+    return skip_lines + _report_results(job, run, args, report, time.perf_counter() - t0)
+
+
+def _checked_run(args, report: Report) -> _Run:
+    """The settings, and every file the run reads and writes, checked before a long load."""
+    from .blender.paths import example_path
+    from .cli_skip import run_key
     from .core.bake.job_options import JobOptions
     from .core.bake.settings import BakeSettings
+    from .core.imageio import check_writable
 
     settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
     options = validated(settings_from_args(args, JobOptions), JobOptions)
@@ -61,10 +105,14 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     literal = [(path, what) for path, what in image_outputs(args, to_colors) if not has_token(path)]
     check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
     key = run_key(args, [Path(path) for path, _what in reads])
-    with report.phase("load"):
-        progress.update("loading")
-        load_scene(source)
-    check_signals()
+    return _Run(settings, options, source, frames, gltf_out, mesh_out, reads, writes, key)
+
+
+def _pick_objects(args, report: Report) -> tuple[list, list | None, object]:
+    """(the meshes to bake, the Selected-to-Active high-poly or None, the cage or None) of
+    the loaded input, as the options name them."""
+    import bpy
+
     high_poly = pick_high_poly(args.high_poly) if args.high_poly else None
     cage = pick_mesh(args.cage, "--cage") if args.cage else None
     if cage is not None and high_poly is None:
@@ -85,47 +133,57 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     if high_poly is not None:
         report.settings["high_poly"] = [o.name for o in high_poly]
         report.settings["cage"] = cage.name if cage else ""
-    request = BakeRequest(targets=targets, settings=settings, options=options, frames=frames,
-                          uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
-                          filepath="" if to_colors else str(Path(os.path.abspath(args.out))),
-                          source_path=str(source),
-                          high_poly=high_poly, cage=cage,
-                          bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
-                          wire_material=gltf_out is not None,
-                          extra_inputs=reads + list(getattr(args, "batch_inputs", [])),
-                          extra_outputs=writes, claimed=list(getattr(args, "batch_outputs", [])),
-                          file_text={BAKE_KEY: key})
-    job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
-    skip_lines = []
-    if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
-        left, skip_lines = skip_finished(request, key, report)
-        if left is None:
-            return skip_lines
-        if left is not request:  # the frames still missing
-            request = left
-            job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
-    start_gpu()
-    t0 = time.perf_counter()
+    return targets, high_poly, cage
+
+
+def _request(args, run: _Run, targets: list, high_poly: list | None, cage):
+    """The job's BakeRequest: what to bake, and every file the run reads and writes."""
+    from .blender.bake_job import BakeRequest
+    from .core.imageio import BAKE_KEY
+
+    return BakeRequest(targets=targets, settings=run.settings, options=run.options, frames=run.frames,
+                       uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
+                       filepath="" if run.to_colors else str(Path(os.path.abspath(args.out))),
+                       source_path=str(run.source), high_poly=high_poly, cage=cage,
+                       bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
+                       wire_material=run.gltf_out is not None,
+                       extra_inputs=run.reads + list(getattr(args, "batch_inputs", [])),
+                       extra_outputs=run.writes, claimed=list(getattr(args, "batch_outputs", [])),
+                       file_text={BAKE_KEY: run.key})
+
+
+def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Progress) -> None:
+    """Run the job, then write its maps and the mesh files all or nothing; on any failure or
+    signal nothing of it is left but a sequence's finished frames (listed in the report)."""
     try:
         with report.phase("bake"):
             for fraction, text in job.steps():
                 progress.update(text.split(":")[0], fraction if fraction > 0 else None)
         check_signals()  # never commit a run that was asked to stop
-        if gltf_out is not None and any(result.tiles for _o, _u, result in job.results):
+        if run.gltf_out is not None and any(result.tiles for _o, _u, result in job.results):
             raise CLIError("--gltf-out: glTF has no UDIM tiles, and the UVs baked lie on several; bake without "
                            "--gltf-out")
         with report.phase("write"):
             job.commit(hold=True)  # all or nothing with the mesh files below: a failure puts back the maps
-            if mesh_out is not None:
-                export_mesh_file(targets, mesh_out, colors=True)
-            if gltf_out is not None:
-                export_glb(targets, gltf_out)
+            if run.mesh_out is not None:
+                export_mesh_file(targets, run.mesh_out, colors=True)
+            if run.gltf_out is not None:
+                export_glb(targets, run.gltf_out)
             job.release()
     except BaseException:
         job.cancel()
         _report_frames(job, report)  # a sequence's finished frames stay, and are listed
         report.kept = job.written_note()
         raise
+
+
+def _report_results(job, run: _Run, args, report: Report, seconds: float) -> list[str]:
+    """The report's objects, outputs and warnings of a finished job; returns its summary lines."""
+    from .blender.bake_job import output_path_for
+    from .blender.color_attributes import AO_ATTRIBUTE
+    from .blender.paths import frame_pattern
+
+    request, settings = job.request, run.settings
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
     for obj, uv_name, result in job.results:
         st = result.stats
@@ -136,7 +194,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
                                    **({"texture_set": True} if args.texture_set else {}),
                                    **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
                                    **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
-    lines = skip_lines
+    lines = []
     for obj, label, result in job.baked():
         st = result.stats
         tile_files = job.files.get((label, "ao"), [])
@@ -146,16 +204,17 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
-                 f"'{AO_ATTRIBUTE}')" if to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
-        frames, dest = "", str(mesh_out) if to_colors else ", ".join(tile_files) or output_path_for(request, obj)
+                 f"'{AO_ATTRIBUTE}')" if run.to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
+        dest = str(run.mesh_out) if run.to_colors else ", ".join(tile_files) or output_path_for(request, obj)
+        frames = ""
         if request.frames:
             reused = sum(e["reused"] for e in job.frame_results)
             frames = f" x {len(request.frames)} frames ({reused} reused, same geometry)"
             dest = frame_pattern(output_path_for(request, obj))
         lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {settings.directions} "
-                     f"directions{frames} in {time.perf_counter() - t0:.2f} s -> {dest}")
-    if gltf_out is not None:
-        report.outputs.append(str(gltf_out))
+                     f"directions{frames} in {seconds:.2f} s -> {dest}")
+    if run.gltf_out is not None:
+        report.outputs.append(str(run.gltf_out))
     if request.frames:
         _report_frames(job, report)
     return lines

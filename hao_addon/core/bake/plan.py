@@ -115,7 +115,8 @@ class BakePlan:
     @property
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
-        return abilities_needed(self.settings.max_distance, self.settings.bent_normals, self.kind, self.udim is not None)
+        settings = self.settings
+        return abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None)
 
     def check_method(self, method: str) -> None:
         """Refuse `method` if it cannot bake this plan (core/bake/abilities.py)."""
@@ -306,13 +307,16 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
         dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
     elif kind.needs_uvs:
-        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale, choose_method(settings.method, needs))
+        method = choose_method(settings.method, needs)
+        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale, method)
     else:  # Size pixels across the bounding sphere's diameter (2), times sqrt(view samples)
         pixel_size, dense_fraction = 2.0 / (settings.size * float(np.sqrt(settings.view_samples))), 0.0
     # The receivers' sphere has diameter 2 (the target's), or 2 extent in Selected to Active.
     pixel_size = max(pixel_size, 2.0 * extent / (MAX_VIEW_SIDE - 4))
 
-    drawn_parts = [t_pos.reshape(-1, 3), o_pos.reshape(-1, 3)] if kind.target_occludes else [o_pos.reshape(-1, 3)]
+    drawn_parts = [o_pos.reshape(-1, 3)]
+    if kind.target_occludes:
+        drawn_parts.insert(0, t_pos.reshape(-1, 3))
     drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
