@@ -52,8 +52,12 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         progress.update("loading")
         load_scene(run.source)
     check_signals()
-    targets, high_poly, cage = _pick_objects(args, report)
-    request = _request(args, run, targets, high_poly, cage)
+    groups = _pick_groups(args, run, report) if run.options.match_names else None
+    if groups is not None:
+        targets, high_poly, cage = [low for group in groups for low in group.lows], None, None
+    else:
+        targets, high_poly, cage = _pick_objects(args, report)
+    request = _request(args, run, targets, high_poly, cage, groups)
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     skip_lines = []
     if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
@@ -136,7 +140,28 @@ def _pick_objects(args, report: Report) -> tuple[list, list | None, object]:
     return targets, high_poly, cage
 
 
-def _request(args, run: _Run, targets: list, high_poly: list | None, cage):
+def _pick_groups(args, run: _Run, report: Report) -> list:
+    """The bake groups of the loaded input's meshes, matched by name (--match-names); the
+    names that matched nothing become warnings."""
+    import bpy
+
+    from .blender.bake_groups import bake_groups
+
+    for option, given in (("--object", args.object), ("--high-poly", args.high_poly), ("--cage", args.cage),
+                          ("--all-meshes", args.all_meshes)):
+        if given:
+            raise CLIError(f"--match-names finds the meshes by name: {option} does not apply")
+    groups, notes = bake_groups(list(bpy.context.view_layer.objects), run.options)
+    if not groups:
+        raise CLIError(f"--match-names: no mesh name (or collection) ends in '{run.options.low_suffix}' "
+                       f"(meshes: {', '.join(o.name for o in bpy.context.view_layer.objects if o.type == 'MESH')})")
+    report.warnings.extend(notes)
+    report.settings["groups"] = {g.name: {"low": [o.name for o in g.lows], "high": [o.name for o in g.highs]}
+                                 for g in groups}
+    return groups
+
+
+def _request(args, run: _Run, targets: list, high_poly: list | None, cage, groups: list | None = None):
     """The job's BakeRequest: what to bake, and every file the run reads and writes."""
     from .blender.bake_job import BakeRequest
     from .core.imageio import BAKE_KEY
@@ -144,7 +169,7 @@ def _request(args, run: _Run, targets: list, high_poly: list | None, cage):
     return BakeRequest(targets=targets, settings=run.settings, options=run.options, frames=run.frames,
                        uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                        filepath="" if run.to_colors else str(Path(os.path.abspath(args.out))),
-                       source_path=str(run.source), high_poly=high_poly, cage=cage,
+                       source_path=str(run.source), high_poly=high_poly, cage=cage, groups=groups,
                        bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
                        wire_material=run.gltf_out is not None,
                        extra_inputs=run.reads + list(getattr(args, "batch_inputs", [])),

@@ -99,6 +99,8 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         return BakeJob(request, context.evaluated_depsgraph_get)
 
     def _report_done(self, job: BakeJob) -> None:
+        for note in job.request.notes:
+            self.report({'WARNING'}, note)
         for _obj, _uv, result in job.results:
             for warning in result.stats.get("warnings", []):
                 self.report({'WARNING'}, warning)

@@ -48,6 +48,12 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         extrusion.active = settings.selected_to_active and settings.cage_object is None
         extrusion.prop(settings, "cage_extrusion")
         sub.prop(settings, "max_ray_distance")
+        col.prop(settings, "match_names")
+        sub = col.column()
+        sub.active = settings.match_names
+        sub.prop(settings, "low_suffix")
+        sub.prop(settings, "high_suffix")
+        sub.prop(settings, "group_occluders")
         col.separator()
         col.prop(settings, "target")
         if settings.target == "color-attribute":

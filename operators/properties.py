@@ -7,6 +7,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringProperty
 
 from ..hao_addon import compat
+from ..hao_addon.blender.bake_groups import bake_groups
 from ..hao_addon.blender.bake_job import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
 from ..hao_addon.core.bake.job_options import JobOptions
@@ -57,11 +58,15 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         return settings_from(self, BakeSettings)
 
     def to_request(self, targets: list, active=None) -> BakeRequest:
-        """targets: the selected meshes; with Selected to Active the active one is baked and
-        the others (not the cage) are its high-poly sources."""
+        """targets: the selected meshes; with Match Names they form bake groups by name, each
+        low-poly baked from its group's highs; with Selected to Active the active one is
+        baked and the others (not the cage) are its high-poly sources."""
         uv = {'AUTO': "AUTO", 'ACTIVE': "", 'NAMED': self.uv_map}[self.uv_mode]
-        high_poly, cage = None, None
-        if self.selected_to_active:
+        high_poly, cage, groups, notes = None, None, None, []
+        if self.match_names:  # the selected meshes' names (or collections) make the groups
+            groups, notes = bake_groups(targets, settings_from(self, JobOptions))
+            targets = [low for group in groups for low in group.lows]
+        elif self.selected_to_active:
             cage = self.cage_object
             high_poly = [o for o in targets if o != active and o != cage]
             if not high_poly and cage in targets:  # the cage alone besides the low-poly: say so, as the CLI does
@@ -71,7 +76,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         to_image = settings.target == "image"  # a colour attribute ignores the image outputs
         options = settings_from(self, JobOptions)
         options = replace(options, texture_set=options.texture_set and to_image and not self.selected_to_active)
-        return BakeRequest(targets=targets, settings=settings, options=options, uv_map=uv,
+        return BakeRequest(targets=targets, settings=settings, options=options, uv_map=uv, groups=groups, notes=notes,
                            image=self.image if to_image else None, filepath=self.filepath if to_image else "",
                            wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,

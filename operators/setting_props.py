@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..hao_addon.core.setting_spec import specs
 
@@ -43,6 +43,8 @@ def blender_property(field, spec, update=None):
         return EnumProperty(items=enum_items(spec.choices), **kw)
     if isinstance(field.default, bool):
         return BoolProperty(**kw)
+    if isinstance(field.default, str):
+        return StringProperty(**kw)
     low, high = spec.minimum, spec.maximum
     if low is not None and spec.above_minimum:
         low = low + EXCLUSIVE_MIN_STEP

@@ -44,6 +44,28 @@ TEXTURE_SET_NAME = "TextureSet"
 
 
 @dataclass
+class BakeGroup:
+    """A bake group (core/bake/name_groups.py): each low-poly is baked from the highs
+    (Selected to Active), or, without highs, as itself."""
+
+    name: str
+    lows: list
+    highs: list
+
+
+@dataclass
+class BakeUnit:
+    """One bake of a job: the objects baked together (one, or a texture set's), the label
+    its image and files are named after, the Selected-to-Active sources (None: the objects'
+    own surface) and the other meshes that occlude."""
+
+    label: str
+    objects: list
+    sources: list | None
+    occluders: list
+
+
+@dataclass
 class BakeRequest:
     """targets: mesh objects to bake. occluders: 'TARGET' (self only), 'SELECTED' (the other
     selected meshes too) or 'VISIBLE' (every visible mesh). uv_map: a UV map name, '' for the
@@ -87,6 +109,11 @@ class BakeRequest:
     extra_outputs: list = field(default_factory=list)
     # Files others write (a batch's earlier inputs' outputs): this run must not write them.
     claimed: list = field(default_factory=list)
+    # Bake groups matched by name (options.match_names): every low-poly of each group is a
+    # target (targets lists them all), baked from its group's highs; None: no groups.
+    groups: list[BakeGroup] | None = None
+    # Warnings from making the request (bake groups: the names that matched nothing).
+    notes: list[str] = field(default_factory=list)
     # Text entries every image file of the run carries (core/imageio.py's BAKE_KEY: what made
     # it, for --skip-existing).
     file_text: dict = field(default_factory=dict)
@@ -132,7 +159,9 @@ def output_path_for(request: BakeRequest, obj, filepath: str | None = None, fram
 def validate_request(request: BakeRequest) -> None:
     """Raise BakeInputError for anything that can be refused before touching the scene."""
     request.settings.validated()
-    if request.high_poly is not None:
+    if request.groups is not None:
+        _validate_groups(request)
+    elif request.high_poly is not None:
         _validate_high_to_low(request)
     elif request.cage is not None:
         raise BakeInputError("a cage object is used only with Selected to Active")
@@ -272,6 +301,20 @@ def _validate_color_attribute(request: BakeRequest) -> None:
                              "bake to Image Textures")
 
 
+def _validate_groups(request: BakeRequest) -> None:
+    if request.high_poly is not None or request.cage is not None:
+        raise BakeInputError("bake groups find their high-poly meshes by name: no separate high-poly or cage")
+    if request.options.texture_set or request.to_color_attribute:
+        raise BakeInputError("bake groups bake each low-poly into its own image (not a texture set or a colour "
+                             "attribute)")
+    if not request.groups:
+        raise BakeInputError(f"no bake group found: no mesh name ends in '{request.options.low_suffix}'")
+    for group in request.groups:
+        for obj in group.highs:
+            if obj.type != 'MESH' or len(obj.data.polygons) == 0:
+                raise BakeInputError(f"high-poly '{obj.name}' of group '{group.name}' is not a mesh with faces")
+
+
 def _validate_high_to_low(request: BakeRequest) -> None:
     if len(request.targets) != 1 or request.targets[0] is None:
         raise BakeInputError("Selected to Active bakes onto one low-poly mesh: make it the active object")
@@ -365,12 +408,39 @@ class BakeJob:
                 out.append(o)
         return out
 
-    def _high_to_low(self, low, depsgraph) -> HighToLow:
-        """The Selected-to-Active request of the low-poly: its sources with their shading,
-        the normals Blender extrudes along, the cage's evaluated corners."""
+    def units(self) -> list[BakeUnit]:
+        """The job's bakes: one per target, one for a texture set, or one per low-poly of
+        each bake group (its sources the group's highs; its occluders by group_occluders)."""
+        req = self.request
+        if req.groups is not None:
+            return [self._group_unit(group, low) for group in req.groups for low in group.lows]
+        skip = set(req.high_poly or ()) | {req.cage}
+        if req.options.texture_set:
+            objects = list(req.targets)
+            return [BakeUnit(TEXTURE_SET_NAME, objects, None,
+                             [o for o in self._occluder_objects(objects[0]) if o not in skip | set(objects)])]
+        return [BakeUnit(obj.name, [obj], req.high_poly, [o for o in self._occluder_objects(obj) if o not in skip])
+                for obj in req.targets]
+
+    def _group_unit(self, group: BakeGroup, low) -> BakeUnit:
+        """A low-poly of a bake group. 'group': its own group occludes (the highs, which are
+        the sources; or, without highs, the group's other lows). 'all': every visible mesh but
+        the lows that stand in for highs."""
+        sources = list(group.highs) or None
+        if self.request.options.group_occluders == "group":
+            occluders = [] if sources else [o for o in group.lows if o != low]
+        else:
+            stand_ins = {o for g in self.request.groups if g.highs for o in g.lows}
+            occluders = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()
+                         and o not in stand_ins and o != low and o not in (sources or ())]
+        return BakeUnit(low.name, [low], sources, occluders)
+
+    def _high_to_low(self, low, depsgraph, high_poly: list) -> HighToLow:
+        """The Selected-to-Active request of the low-poly: its sources (high_poly) with their
+        shading, the normals Blender extrudes along, the cage's evaluated corners."""
         req = self.request
         sources = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=req.settings.normals == "mesh")
-                   for o in req.high_poly]
+                   for o in high_poly]
         normals, linear = mesh_data.extrusion_normals(low, depsgraph)
         cage = None
         if req.cage is not None:
@@ -411,23 +481,21 @@ class BakeJob:
         progress runs from start over share of the bar."""
         req = self.request
         depsgraph = self._depsgraph_getter()
-        units = [req.targets] if req.options.texture_set else [[obj] for obj in req.targets]
+        units = self.units()
         at = "" if frame is None else f" at frame {frame}"
-        for k, objects in enumerate(units):
+        for k, unit in enumerate(units):
+            objects, label = unit.objects, unit.label
             obj = objects[0]
-            label = TEXTURE_SET_NAME if req.options.texture_set else obj.name
             parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
                                               shading_normals=req.settings.normals == "mesh") for o in objects]
             soup = texture_set_target(parts, req.settings.size, label) if req.options.texture_set else parts[0]
             corners = None
             if req.to_color_attribute:
                 corners = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
-            high_to_low = self._high_to_low(obj, depsgraph) if req.high_poly is not None else None
+            high_to_low = self._high_to_low(obj, depsgraph, unit.sources) if unit.sources is not None else None
             target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
-            skip = set(req.high_poly or ()) | {req.cage} | set(objects)
-            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False)
-                         for o in self._occluder_objects(obj) if o not in skip]
-            settings = terminator_settings(req.settings, req.high_poly or objects)
+            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False) for o in unit.occluders]
+            settings = terminator_settings(req.settings, unit.sources or objects)
             key = None
             if frame is not None:
                 key = (label, bake_key(target, occluders, settings))

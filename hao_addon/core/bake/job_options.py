@@ -8,9 +8,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..setting_spec import Choice, setting, validate
+from ..setting_spec import Choice, SettingError, setting, validate
 from .tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
 
+GROUP_OCCLUDER_CHOICES = (
+    Choice("group", "Group", "only the group's own meshes occlude its low-poly (an exploded bake without moving "
+                             "anything)"),
+    Choice("all", "All", "every mesh occludes every group (to ground the parts), except the low-poly meshes "
+                         "that stand in for a high-poly"),
+)
 OCCLUDER_CHOICES = (
     Choice("target", "Self", "only the baked mesh itself (Selected to Active: the high-poly only)"),
     Choice("selected", "Selected", "the baked mesh and the other selected meshes"),
@@ -38,7 +44,25 @@ class JobOptions:
         "opengl", label="Convention", noun="bent-normal convention", choices=CONVENTION_CHOICES,
         description="which way the bent normals' green channel points")
 
+    match_names: bool = setting(
+        False, label="Match Names",
+        description="bake groups matched by name: each low-poly (name ending in the low suffix, or in a collection "
+                    "so named; Blender's .001 numbers ignored) from its own group's high-poly meshes (Selected to "
+                    "Active), every group in one run; a group without high-poly meshes bakes its own parts; names "
+                    "that match nothing are listed")
+    low_suffix: str = setting(
+        "_low", label="Low Suffix", noun="low-poly suffix", description="what ends a low-poly's name (Match Names)")
+    high_suffix: str = setting(
+        "_high", label="High Suffix", noun="high-poly suffix", description="what ends a high-poly's name (Match Names)")
+    group_occluders: str = setting(
+        "group", label="Group Occluders", choices=GROUP_OCCLUDER_CHOICES,
+        description="Match Names: which meshes occlude a group (Occluders does not apply)")
+
     def validated(self) -> "JobOptions":
         """Return self, or raise SettingError naming the option."""
         validate(self)
+        if self.match_names and (not self.low_suffix or not self.high_suffix
+                                 or self.low_suffix.lower() == self.high_suffix.lower()):
+            raise SettingError("high_suffix", f"the low and high suffixes must differ and not be empty, got "
+                                              f"'{self.low_suffix}' and '{self.high_suffix}'")
         return self
