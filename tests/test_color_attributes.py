@@ -199,7 +199,8 @@ def test_cli_saves_the_mesh_with_its_colour_attribute(tmp_path, suffix):
     assert "into colour attribute 'hao_ao'" in run.stdout and out.is_file()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left
     if suffix == ".glb":
-        from test_gltf import read_glb
+        from test_gltf import assert_valid_gltf, read_glb
+        assert_valid_gltf(out)
         doc, binary = read_glb(out)
         attributes = doc["meshes"][0]["primitives"][0]["attributes"]
         accessor = doc["accessors"][attributes["COLOR_0"]]

@@ -7,12 +7,26 @@ from __future__ import annotations
 
 import json
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import bpy
 from conftest import small_settings
+
+
+VALIDATE = Path(__file__).resolve().parent.parent / "tools" / "gltf_validate.cjs"
+
+
+def assert_valid_gltf(path) -> None:
+    """The Khronos glTF Validator (tools/gltf_validate.cjs; installed by tools/setup.sh)
+    finds no error in the file."""
+    import subprocess
+    done = subprocess.run(["node", str(VALIDATE), str(path)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, (done.stdout, done.stderr)
+    report = json.loads(done.stdout.splitlines()[-1])
+    assert report["errors"] == 0, report
 
 
 def read_glb(path) -> tuple[dict, bytes]:
@@ -72,6 +86,7 @@ def test_exported_glb_carries_the_baked_map_as_occlusion(scene, tmp_path, uv_map
     ao = ao.reshape(64, 64, 4)[..., 0]
     path = tmp_path / "baked.glb"
     assert bpy.ops.export_scene.gltf(filepath=str(path), export_format='GLB', use_selection=True) == {'FINISHED'}
+    assert_valid_gltf(path)
     doc, binary = read_glb(path)
     red, tex_coord, mime = occlusion_of(doc, binary, tmp_path)
     order = [layer.name for layer in mesh.uv_layers]
@@ -93,6 +108,7 @@ def test_cli_gltf_out_writes_the_asset_with_its_occlusion(tmp_path):
     proc = run(["bake", SPOT, "--size", "64", "--directions", "16", "--out", out, "--gltf-out", glb, "--quiet"], tmp)
     assert proc.returncode == 0, proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ao.png", "spot.glb", "tmp"]  # no temporary left
+    assert_valid_gltf(glb)
     doc, binary = read_glb(glb)
     red, tex_coord, _mime = occlusion_of(doc, binary, tmp_path)
     written = bpy.data.images.load(str(out))

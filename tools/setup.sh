@@ -31,6 +31,22 @@ venv="$(venv_for "$release")"
 pyver="$(python_version_for "$release")"
 py="$(find_python "$pyver")"
 
+# The Khronos glTF Validator (npm's gltf-validator: one JavaScript file, no dependencies),
+# fetched by its pinned checksum; the tests validate every .glb the bake exports with it
+# (tools/gltf_validate.cjs).
+GLTF_VALIDATOR_URL="https://registry.npmjs.org/gltf-validator/-/gltf-validator-2.0.0-dev.3.10.tgz"
+GLTF_VALIDATOR_SHA1="9b09225db864fe3f0a584259f65d087e2213a93a"
+if [ ! -f .tools/gltf-validator/package/index.js ]; then
+  "$py" - "$GLTF_VALIDATOR_URL" "$GLTF_VALIDATOR_SHA1" <<'PY'
+import hashlib, io, sys, tarfile, urllib.request
+data = urllib.request.urlopen(sys.argv[1], timeout=120).read()
+if hashlib.sha1(data).hexdigest() != sys.argv[2]:
+    sys.exit("gltf-validator: checksum mismatch")
+archive = tarfile.open(fileobj=io.BytesIO(data))
+archive.extractall(".tools/gltf-validator", **({"filter": "data"} if hasattr(tarfile, "data_filter") else {}))
+PY
+fi
+
 if [ -x "$venv/bin/python" ] && ! "$venv/bin/python" -c "import sys; sys.exit(sys.version[:len('$pyver')+1] != '$pyver.')"; then
   rm -rf "$venv"  # made with another Python: pinned wheels would not match
 fi
