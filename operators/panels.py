@@ -71,6 +71,11 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
         col.prop(settings, "filepath")
+        sub = col.column()
+        sub.prop(settings, "png_bits")
+        dither = sub.column()
+        dither.active = settings.png_bits == "8"
+        dither.prop(settings, "dither")
         col.prop(settings, "frame_range")
         col.prop(settings, "wire_material")
         col.prop(settings, "bent_normals")

@@ -205,6 +205,7 @@ CASES = [
      "names the same mesh twice"),
     ("match-names-with-high-poly", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names", "--high-poly",
                                     "spot"], 2, "--match-names finds the meshes by name: --high-poly does not apply"),
+    ("dither-16-bit", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--dither"], 2, "add --png-bits 8"),
     ("match-names-no-group", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names"], 2,
      "no mesh name (or collection) ends in '_low'"),
     ("match-names-same-suffixes", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names", "--low-suffix",

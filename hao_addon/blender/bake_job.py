@@ -632,7 +632,8 @@ class BakeJob:
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
-                            staged.write_image(file_path, tile_map, req.file_text)
+                            staged.write_image(file_path, tile_map, req.file_text, req.options.png_bit_depth,
+                                               req.options.dither)
                     self.files.setdefault((label, kind), []).extend(paths)
         except BaseException:
             staged.discard()

@@ -141,9 +141,11 @@ class StagedFiles:
             fh.write(data)
         os.chmod(tmp, 0o666 & ~_umask())
 
-    def write_image(self, path: str | Path, image: np.ndarray, text: dict[str, str] | None = None) -> None:
-        """(H, W) or (H, W, 4) to .png (16-bit) or .exr (32-bit float), as write_ao_file."""
-        self.write_bytes(path, encode_image(path, image, text))
+    def write_image(self, path: str | Path, image: np.ndarray, text: dict[str, str] | None = None,
+                    png_bits: int = 16, dither: bool = False) -> None:
+        """(H, W) or (H, W, 4) to .png (16-bit, or png_bits) or .exr (32-bit float), as
+        encode_image."""
+        self.write_bytes(path, encode_image(path, image, text, png_bits, dither))
 
     def commit(self) -> list[str]:
         """Rename every staged file into place; returns their paths. On failure, rolls back."""
@@ -198,23 +200,49 @@ def _umask() -> int:
 BAKE_KEY = "hao_bake_key"
 
 
-def png16_bytes(image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
-    """16-bit PNG of image (H, W) gray or (H, W, 4) RGBA in [0, 1], row 0 = bottom; text:
-    Latin-1 tEXt entries (keyword -> value), before the image data."""
-    img = np.clip(np.nan_to_num(np.asarray(image, np.float64)), 0.0, 1.0)
+# The dither's noise is drawn from this seed for each image shape: a re-run writes the same
+# bytes (a farm task re-run after a kill included).
+DITHER_SEED = 0x4A0D17
+
+
+def quantized(image: np.ndarray, bits: int, dither: bool = False) -> np.ndarray:
+    """image (H, W[, C]) in [0, 1] as unsigned integers of `bits` bits (uint16 or uint8):
+    rounded; or, with dither, floor(v L + u) with u uniform in [0, 1) per sample (L the top
+    level): its mean over many samples is exactly v L, so a smooth gradient shows no bands,
+    and a value on a level (0, 1, any k / L) stays on it, noise-free."""
+    top = (1 << bits) - 1
+    scaled = np.clip(np.nan_to_num(np.asarray(image, np.float64)), 0.0, 1.0) * top
+    if dither:
+        noise = np.random.Generator(np.random.PCG64(DITHER_SEED)).random(scaled.shape)
+        levels = np.floor(scaled + noise)
+        on_level = np.abs(scaled - np.round(scaled)) < 1e-9  # float error must not push a level off
+        levels = np.where(on_level, np.round(scaled), levels)
+    else:
+        levels = np.round(scaled)
+    return np.clip(levels, 0, top).astype(np.uint16 if bits == 16 else np.uint8)
+
+
+def png16_bytes(image: np.ndarray, text: dict[str, str] | None = None, bits: int = 16,
+                dither: bool = False) -> bytes:
+    """16-bit (or 8-bit: bits) PNG of image (H, W) gray or (H, W, 4) RGBA in [0, 1], row 0 =
+    bottom, quantized (dither: see quantized); text: Latin-1 tEXt entries (keyword -> value),
+    before the image data."""
+    img = np.asarray(image)
     h, w = img.shape[:2]
     channels = 1 if img.ndim == 2 else img.shape[2]
     if channels not in (1, 4):
         raise ValueError(f"PNG writer takes gray or RGBA images, got {channels} channels")
-    q = np.round(img[::-1] * 65535.0).astype(">u2")  # flip to top-first, big-endian samples
-    row_bytes = 2 * w * channels
+    if bits not in (8, 16):
+        raise ValueError(f"PNG writer takes 8 or 16 bits, got {bits}")
+    q = quantized(img[::-1], bits, dither).astype(">u2" if bits == 16 else np.uint8)  # top-first, big-endian
+    row_bytes = (bits // 8) * w * channels
     raw = np.concatenate([np.zeros((h, 1), np.uint8), q.view(np.uint8).reshape(h, row_bytes)], axis=1)
 
     def chunk(tag: bytes, payload: bytes) -> bytes:
         return struct.pack(">I", len(payload)) + tag + payload + struct.pack(">I", zlib.crc32(tag + payload))
 
     colour_type = 0 if channels == 1 else 6  # gray or RGBA
-    ihdr = struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0)
+    ihdr = struct.pack(">IIBBBBB", w, h, bits, colour_type, 0, 0, 0)
     texts = b"".join(chunk(b"tEXt", key.encode("latin-1") + b"\0" + value.encode("latin-1"))
                      for key, value in sorted((text or {}).items()))
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + texts + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
@@ -262,13 +290,15 @@ def exr32_bytes(image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
     return header + offsets + rows.tobytes()
 
 
-def encode_image(path: str | Path, image: np.ndarray, text: dict[str, str] | None = None) -> bytes:
+def encode_image(path: str | Path, image: np.ndarray, text: dict[str, str] | None = None, png_bits: int = 16,
+                 dither: bool = False) -> bytes:
     """The file bytes of (H, W) accessibility, or (H, W, 4) RGBA, for path's format, with
-    text entries (keyword -> value) in its metadata."""
+    text entries (keyword -> value) in its metadata; a PNG of png_bits bits, dithered where
+    asked (an EXR is 32-bit float either way)."""
     fmt = format_for_path(path)
     if not np.isfinite(image).all():
         raise ValueError("refusing to write an AO map containing NaN or Inf")
-    return png16_bytes(image, text) if fmt == "PNG" else exr32_bytes(image, text)
+    return png16_bytes(image, text, png_bits, dither) if fmt == "PNG" else exr32_bytes(image, text)
 
 
 def read_text(path: str | Path, keyword: str) -> str | None:

@@ -17,6 +17,10 @@ GROUP_OCCLUDER_CHOICES = (
     Choice("all", "All", "every mesh occludes every group (to ground the parts), except the low-poly meshes "
                          "that stand in for a high-poly"),
 )
+PNG_BITS_CHOICES = (
+    Choice("16", "16-bit", "smooth as baked"),
+    Choice("8", "8-bit", "for engines and texture budgets; see Dither"),
+)
 OCCLUDER_CHOICES = (
     Choice("target", "Self", "only the baked mesh itself (Selected to Active: the high-poly only)"),
     Choice("selected", "Selected", "the baked mesh and the other selected meshes"),
@@ -44,6 +48,13 @@ class JobOptions:
         "opengl", label="Convention", noun="bent-normal convention", choices=CONVENTION_CHOICES,
         description="which way the bent normals' green channel points")
 
+    png_bits: str = setting(
+        "16", label="PNG Bits", noun="PNG bit depth", choices=PNG_BITS_CHOICES,
+        description="bits per sample of PNG files (EXR files are 32-bit float either way)")
+    dither: bool = setting(
+        False, label="Dither",
+        description="8-bit PNG: add a noise below one step before rounding, so that smooth gradients show no bands "
+                    "(the same bytes on every run); levels such as 1.0 stay exact")
     match_names: bool = setting(
         False, label="Match Names",
         description="bake groups matched by name: each low-poly (name ending in the low suffix, or in a collection "
@@ -58,9 +69,15 @@ class JobOptions:
         "group", label="Group Occluders", choices=GROUP_OCCLUDER_CHOICES,
         description="Match Names: which meshes occlude a group (Occluders does not apply)")
 
+    @property
+    def png_bit_depth(self) -> int:
+        return int(self.png_bits)
+
     def validated(self) -> "JobOptions":
         """Return self, or raise SettingError naming the option."""
         validate(self)
+        if self.dither and self.png_bits != "8":
+            raise SettingError("dither", "dither applies to 8-bit PNG files: add --png-bits 8")
         if self.match_names and (not self.low_suffix or not self.high_suffix
                                  or self.low_suffix.lower() == self.high_suffix.lower()):
             raise SettingError("high_suffix", f"the low and high suffixes must differ and not be empty, got "
