@@ -11,20 +11,20 @@ from __future__ import annotations
 import hashlib
 import time
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Generator
 
 import numpy as np
 
 from .core.blas_threads import single_threaded_blas
-from .core.geometry import TriangleSoup
+from .core.geometry import TriangleSoup, bounding_sphere
 from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
 from .core.bake.seams import element_values, finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
-from .core.bake.abilities import choose_method
+from .core.bake.abilities import check_method, choose_method
 from .core.bake.targets import BakeTarget, as_bake_target
 from .core.bake.vertex_target import VertexTarget
 
@@ -182,6 +182,35 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     return BakeResult(ao, covered, filled, stats, bent, tile_numbers)
 
 
+def inverted(soup: TriangleSoup) -> TriangleSoup:
+    """The soup seen from inside: every triangle's winding (and so its normal) reversed, its
+    shading normals negated, its UVs kept on the same corners."""
+    normals = None if soup.normals is None else -soup.normals[:, ::-1]
+    uvs = None if soup.uvs is None else soup.uvs[:, ::-1]
+    return TriangleSoup(soup.positions[:, ::-1], uvs, soup.name, normals)
+
+
+def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: bool = True
+                    ) -> Generator[float, None, BakeResult]:
+    """Thickness of `target`'s own surface in its UV layout (settings.thickness_distance, 0
+    = the target's bounding-sphere radius): the occlusion, by the mesh itself, of the
+    hemisphere about the inverted normal, i.e. the AO bake of the inverted soup with that
+    max distance, as 1 - accessibility (1 thin, 0 nothing within reach; 0 outside the map's
+    charts). Yields progress as bake_steps."""
+    distance = settings.thickness_distance
+    if distance == 0.0:
+        distance = float(bounding_sphere(target.positions.reshape(-1, 3))[1])
+    inside = replace(settings, max_distance=distance, bent_normals=False, thickness=False, target="image")
+    # Its own method: a baker must be able to bake thickness (core/bake/abilities.py).
+    needs = inside.abilities_needed(False) | {"thickness"}
+    method = choose_method(settings.method, needs)
+    check_method(method, needs)
+    inside = replace(inside, method=method)
+    result = yield from bake_steps(inverted(target), [], inside, use_cache)
+    stats = {**result.stats, "thickness_distance": distance}
+    return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles)
+
+
 def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
          progress: Callable[[float], None] | None = None, use_cache: bool = True,
          high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> BakeResult:
@@ -200,4 +229,4 @@ def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], setti
 
 
 __all__ = ["BakeInputError", "BakeResult", "BakeTarget", "HighToLow", "VertexTarget", "bake", "bake_key", "bake_steps",
-           "clear_cache"]
+           "clear_cache", "inverted", "thickness_steps"]

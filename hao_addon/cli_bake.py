@@ -90,12 +90,16 @@ def _checked_run(args, report: Report) -> _Run:
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
     to_colors = settings.target == "color-attribute"
-    if to_colors and (args.bent_normal_out or args.gltf_out):
+    if to_colors and (args.bent_normal_out or args.gltf_out or args.thickness_out):
         raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out "
-                       "(.blend, .glb or .ply); --bent-normal-out and --gltf-out are image bakes")
+                       "(.blend, .glb or .ply); --bent-normal-out, --thickness-out and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
         check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
+                       source=source)
+    if args.thickness_out:
+        settings = replace(settings, thickness=True)
+        check_writable(example_path(args.thickness_out, first_frame), settings.size, settings.size, 1,
                        source=source)
     gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
@@ -171,6 +175,7 @@ def _request(args, run: _Run, targets: list, high_poly: list | None, cage, group
                        filepath="" if run.to_colors else str(Path(os.path.abspath(args.out))),
                        source_path=str(run.source), high_poly=high_poly, cage=cage, groups=groups,
                        bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
+                       thickness_filepath=str(Path(os.path.abspath(args.thickness_out))) if args.thickness_out else "",
                        wire_material=run.gltf_out is not None,
                        extra_inputs=run.reads + list(getattr(args, "batch_inputs", [])),
                        extra_outputs=run.writes, claimed=list(getattr(args, "batch_outputs", [])),
@@ -226,6 +231,7 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
         if not request.frames:  # a sequence's files are listed frame by frame (_report_frames)
             report.outputs.extend(tile_files if len(tile_files) > 1 else [output_path_for(request, obj)])
             report.outputs.extend(job.files.get((label, "bent"), []))
+            report.outputs.extend(job.files.get((label, "thickness"), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
@@ -275,7 +281,8 @@ def image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
     """The image files named on the command line (patterns, tokens unfilled)."""
     if to_colors:
         return []
-    return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)")]
+    return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)"),
+            (args.thickness_out or "", "the thickness map (--thickness-out)")]
 
 
 def has_token(path: str) -> bool:
@@ -296,7 +303,7 @@ def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
     from .blender.paths import input_file_name
     name = input_file_name(path)
-    for option in ("out", "bent_normal_out", "gltf_out"):
+    for option in ("out", "bent_normal_out", "thickness_out", "gltf_out"):
         value = getattr(args, option)
         if value:
             setattr(args, option, value.replace(INPUT_TOKEN, name))

@@ -102,6 +102,10 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--bent-normal-out", default="", metavar="FILE",
                    help="also bake bent normals (the cosine-weighted mean unoccluded direction, same pass) into "
                         "this .png (16-bit) or .exr (32-bit float) RGB file, 0.5 + 0.5 n; {object} as in --out")
+    b.add_argument("--thickness-out", default="", metavar="FILE",
+                   help="also bake thickness (the occlusion of the inverted hemisphere by the mesh itself within "
+                        "--thickness-distance; 1 thin, 0 nothing within reach) into this .png (16-bit) or .exr "
+                        "(32-bit float) file; {object} as in --out")
     b.add_argument("--gltf-out", default="", metavar="FILE.glb",
                    help="also write the baked object as a .glb with the map as its material's occlusionTexture "
                         "(Blender's glTF exporter; the map on the UV map that was baked)")

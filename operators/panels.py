@@ -84,6 +84,11 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.prop(settings, "bent_space")
         sub.prop(settings, "bent_convention")
         sub.prop(settings, "bent_filepath")
+        col.prop(settings, "thickness")
+        sub = col.column()
+        sub.active = settings.thickness
+        sub.prop(settings, "thickness_distance")
+        sub.prop(settings, "thickness_filepath")
         outer.prop(settings, "view_samples")
         layout.separator()
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')

@@ -45,6 +45,10 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "
                                                  "{object} is replaced by the object's name", default="",
         subtype='FILE_PATH', options=compat.path_property_options())
+    thickness_filepath: StringProperty(
+        name="Save Thickness To", description="Also write the thickness map to this .png (16-bit) or .exr file; "
+                                              "{object} is replaced by the object's name", default="",
+        subtype='FILE_PATH', options=compat.path_property_options())
     frame_range: BoolProperty(
         name="Frame Range",
         description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
@@ -81,6 +85,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                            wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
+                           thickness_filepath=self.thickness_filepath if self.thickness and to_image else "",
                            frames=self.scene_frames() if self.frame_range else None)
 
     def scene_frames(self) -> list[int]:

@@ -11,7 +11,7 @@ import pytest
 
 from hao_addon.core import scenes
 from hao_addon.core.bake.abilities import (ABILITIES, ABILITY_NAMES, BAKE_METHODS, BAKERS, bakers_with,
-                                           choose_method, declaration)
+                                           check_method, choose_method, declaration)
 from hao_addon.core.bake.plan import make_plan
 from hao_addon.core.bake.projection import HighToLow
 from hao_addon.core.bake.settings import METHODS, BakeSettings
@@ -45,6 +45,9 @@ def plan_needing(ability: str, method: str):
         verts, index = np.unique(points.round(9), axis=0, return_inverse=True)
         return make_plan(TriangleSoup(plane.positions, None, "plane"), [], BakeSettings(target="color-attribute", **kw),
                          vertex_target=indexed_vertex_target(index.reshape(-1, 3), len(verts)))
+    if ability == "thickness":  # a need of thickness_steps (tests/test_thickness.py), not of a plan
+        check_method(method, frozenset({"max-distance", "thickness"}))
+        return make_plan(plane, [], BakeSettings(max_distance=1.0, **kw))
     raise AssertionError(f"no scene needs {ability}")
 
 
@@ -54,7 +57,7 @@ def test_a_plan_is_refused_exactly_where_its_method_lacks_the_ability(baker, abi
     refused before any work otherwise, naming what is asked, why, and the methods that can."""
     if baker.can(ability.name):
         plan = plan_needing(ability.name, baker.method)
-        assert ability.name in plan.abilities_needed
+        assert ability.name in plan.abilities_needed or ability.name == "thickness"
         plan.check_method(baker.method)
         return
     with pytest.raises(BakeInputError) as refused:
@@ -78,12 +81,19 @@ def test_every_ability_has_a_gpu_baker_and_the_reference():
 
 
 def test_auto_takes_the_scatter_for_a_max_distance_alone_otherwise_the_gather():
-    """Auto's rule as the benchmark set it, over every combination of needs."""
+    """Auto's rule as the benchmark set it, over every combination of needs: the scatter for
+    a max distance alone, the gather otherwise; thickness, which the gather declares it
+    cannot bake, with the scatter where it can bake the rest, else refused."""
+    scatter_can = {"max-distance", "thickness"}
     for k in range(len(ABILITY_NAMES) + 1):
         for needs in map(frozenset, itertools.combinations(ABILITY_NAMES, k)):
-            expected = "scatter" if needs == {"max-distance"} else "gather"
-            assert choose_method("auto", needs) == expected, needs
             assert choose_method("reference", needs) == "reference"
+            if "thickness" in needs and not needs <= scatter_can:
+                with pytest.raises(BakeInputError, match="no GPU baker can bake"):
+                    choose_method("auto", needs)
+                continue
+            expected = "scatter" if needs in ({"max-distance"}, {"thickness"}, scatter_can) else "gather"
+            assert choose_method("auto", needs) == expected, needs
 
 
 def test_settings_choose_through_the_declarations():

@@ -22,7 +22,7 @@ import bpy
 import numpy as np
 
 from .. import compat
-from ..bake import BakeResult, bake_key, bake_steps
+from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
 from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
 from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
@@ -100,6 +100,7 @@ class BakeRequest:
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None
     bent_filepath: str = ""
+    thickness_filepath: str = ""  # settings.thickness: the thickness map's file (tokens as filepath)
     options: JobOptions = field(default_factory=JobOptions)
     frames: list | None = None
     # What else the caller reads and writes, as (path, what) pairs, so that one check
@@ -190,6 +191,12 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
     if request.bent_filepath and not request.settings.bent_normals:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
+    if request.thickness_filepath and not request.settings.thickness:
+        raise BakeInputError("a thickness file needs the Thickness setting on")
+    if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
+                                       or any(g.highs for g in request.groups or ())):
+        raise BakeInputError("thickness bakes the mesh's own surface into an image (not a colour attribute or "
+                             "Selected to Active)")
     size = request.settings.size
     for obj in _file_owners(request):
         for _kind, filepath, _what, channels in output_kinds(request):
@@ -207,7 +214,8 @@ def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
 
 def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
     """The image files a request writes per target: (kind, path pattern, what, channels)."""
-    return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4))
+    return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4),
+            ("thickness", request.thickness_filepath, "the thickness map", 1))
 
 
 def _file_owners(request: BakeRequest) -> list:
@@ -355,6 +363,7 @@ class BakeJob:
         self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
+        self.thickness_maps: dict[str, np.ndarray] = {}  # object name -> (size, size) thickness
         self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
         # A frame sequence: per frame {frame, seconds, reused, outputs} (its maps are written
@@ -471,6 +480,7 @@ class BakeJob:
                                                reused=all(r.stats.get("cache_hit") for _o, _u, r in self.results),
                                                outputs=outputs))
                 self.bent_images.clear()
+                self.thickness_maps.clear()
         finally:  # also when cancelled: the scene goes back to its frame
             scene.frame_set(original)
         self.finished = True
@@ -519,6 +529,11 @@ class BakeJob:
                            f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%")
             finally:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
+            if settings.thickness:
+                steps = thickness_steps(soup, settings, use_cache=frame is None)
+                thick = yield from _with_status(steps, start + share * (k + 1) / len(units),
+                                                f"Baking thickness of '{label}'{at}")
+                self.thickness_maps[label] = thick.ao
             if settings.bent_normals:
                 self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
                                                            soup, result)
@@ -628,7 +643,8 @@ class BakeJob:
                         for file_path, source in zip(paths, _tile_paths(earlier, result.tiles)):
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
-                        maps = result.ao if kind == "ao" else self.bent_images.get(label)
+                        maps = {"ao": result.ao, "bent": self.bent_images.get(label),
+                                "thickness": self.thickness_maps.get(label)}[kind]
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
@@ -661,10 +677,12 @@ class BakeJob:
             existing = req.image or bpy.data.images.get(name)
             stored[label] = self._store_image(result.ao, result.tiles, name, existing, files.get((label, "ao")))
             self.committed.append(stored[label])
-            if label in self.bent_images:
-                name = f"{label}_BentNormals"
-                self.committed.append(self._store_image(self.bent_images[label], result.tiles, name,
-                                                        bpy.data.images.get(name), files.get((label, "bent"))))
+            for kind, maps, suffix in (("bent", self.bent_images, "BentNormals"),
+                                       ("thickness", self.thickness_maps, "Thickness")):
+                if label in maps:
+                    name = f"{label}_{suffix}"
+                    self.committed.append(self._store_image(maps[label], result.tiles, name,
+                                                            bpy.data.images.get(name), files.get((label, kind))))
         for obj, uv_name, _result in self.results:
             image = stored[self.label_of(obj)]
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
@@ -705,3 +723,4 @@ class BakeJob:
         self.created_uv.clear()
         self.results.clear()
         self.bent_images.clear()
+        self.thickness_maps.clear()

@@ -110,6 +110,14 @@ class BakeSettings:
         False, label="Bent Normals", cli=None, cli_via="--bent-normal-out FILE",
         description="also bake the bent normal: each texel's cosine-weighted mean unoccluded direction, from "
                     "the same directions as the AO (gather and reference; the scatter cannot)")
+    thickness: bool = setting(
+        False, label="Thickness", cli=None, cli_via="--thickness-out FILE",
+        description="also bake thickness (Substance's): the occlusion of the inverted hemisphere, seen from inside "
+                    "the surface, by the mesh itself within Thickness Distance; 1 where a wall is that near in every "
+                    "direction (thin), 0 where none is (images of the mesh's own surface)")
+    thickness_distance: float = setting(
+        0.0, label="Thickness Distance", minimum=0.0, soft_max=10.0, unit="scene units", subtype='DISTANCE',
+        description="how far inside the surface a wall counts for thickness; 0 = the mesh's bounding-sphere radius")
     target: str = setting(
         "image", label="Target", noun="bake target", choices=TARGET_CHOICES,
         description="where the AO goes; a colour attribute samples every vertex with light views as fine as a "
