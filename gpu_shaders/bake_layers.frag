@@ -5,6 +5,12 @@
  * counted so the bake can report them. */
 void main()
 {
+#ifdef ALPHA
+  if (!alpha_keeps()) {
+    dummy_out = 0.0;
+    return;  /* no list entry: the light passes this surface here */
+  }
+#endif
   ivec2 px = ivec2(gl_FragCoord.xy);
   uint slot = imageAtomicAdd(layer_count, px, 1u);
   if (slot < uint(LAYERS)) {

@@ -79,6 +79,10 @@ def bake_key(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], s
         if soup.uvs is not None:
             h.update(np.ascontiguousarray(soup.uvs).tobytes())
         h.update(b"|flat|" if soup.normals is None else np.ascontiguousarray(soup.normals).tobytes())
+        alpha = soup.alpha
+        if alpha is not None:  # what lets light through (core/bake/alpha.py)
+            for part in (alpha.constant, alpha.image_index, alpha.uvs, *alpha.images):
+                h.update(b"|none|" if part is None else np.ascontiguousarray(part).tobytes())
     return h.hexdigest()
 
 

@@ -51,3 +51,15 @@ def object_terminator_offset(obj) -> float | None:
     if cycles is not None and hasattr(cycles, "shadow_terminator_geometry_offset"):
         return float(cycles.shadow_terminator_geometry_offset)
     return None
+
+
+def material_node_tree(material):
+    """The material's node tree where its nodes shade it, else None. Blender 5.0 made every
+    material use nodes (Material.use_nodes is deprecated there, to be removed in 6.0)."""
+    import bpy
+
+    if material is None or material.node_tree is None:
+        return None
+    if bpy.app.version >= (5, 0, 0) or material.use_nodes:
+        return material.node_tree
+    return None

@@ -37,6 +37,10 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         offset.active = settings.normals == 'mesh' and settings.terminator == 'setting'
         offset.prop(settings, "terminator_offset")
         col.prop(settings, "ignore_back_faces")
+        col.prop(settings, "alpha")
+        sub = col.column()
+        sub.active = settings.alpha == "clip"
+        sub.prop(settings, "alpha_clip")
         col.prop(settings, "occluders")
         col.prop(settings, "samples_per_texel")
         col.separator()

@@ -448,7 +448,8 @@ class BakeJob:
         """The Selected-to-Active request of the low-poly: its sources (high_poly) with their
         shading, the normals Blender extrudes along, the cage's evaluated corners."""
         req = self.request
-        sources = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=req.settings.normals == "mesh")
+        sources = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=req.settings.normals == "mesh",
+                                            alpha=req.settings.alpha != "off")
                    for o in high_poly]
         normals, linear = mesh_data.extrusion_normals(low, depsgraph)
         cage = None
@@ -504,7 +505,9 @@ class BakeJob:
                 corners = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
             high_to_low = self._high_to_low(obj, depsgraph, unit.sources) if unit.sources is not None else None
             target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
-            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False) for o in unit.occluders]
+            alpha = req.settings.alpha != "off"
+            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha)
+                         for o in unit.occluders]
             settings = terminator_settings(req.settings, unit.sources or objects)
             key = None
             if frame is not None:

@@ -51,9 +51,10 @@ def corner_normals(mesh: bpy.types.Mesh) -> np.ndarray:
 
 
 def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None,
-                   shading_normals: bool = True) -> TriangleSoup:
+                   shading_normals: bool = True, alpha: bool = False) -> TriangleSoup:
     """The object's evaluated mesh in world space, with the named UV map (or none) and, when
-    asked, the corner shading normals. A mirroring transform (negative determinant) turns
+    asked, the corner shading normals and (alpha) what its materials let through as an
+    occluder (blender/material_alpha.py). A mirroring transform (negative determinant) turns
     the triangles inside out; their corners are reordered so faces keep pointing outwards,
     as Blender and Cycles treat mirrored objects."""
     obj_eval = obj.evaluated_get(depsgraph)
@@ -71,7 +72,11 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
             # Normals transform with the inverse transpose (non-uniform scale bends them).
             normal_matrix = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-300 else linear
             normals = corner_normals(mesh)[tri_loops] @ normal_matrix.T
-        return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals)
+        lets_through = None
+        if alpha:
+            from .material_alpha import soup_alpha
+            lets_through = soup_alpha(obj, mesh, tri_loops)
+        return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals, alpha=lets_through)
     finally:
         obj_eval.to_mesh_clear()
 

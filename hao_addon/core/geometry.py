@@ -16,12 +16,15 @@ class TriangleSoup:
     name: label for messages.
     normals: (F, 3, 3) float64 shading normals at the corners, as the mesh is shaded (smooth,
     sharp edges, custom normals), world space; None: flat (the face normals).
+    alpha: how much light each face stops as an occluder (core/bake/alpha.SoupAlpha), or
+    None: opaque.
     """
 
     positions: np.ndarray
     uvs: np.ndarray | None = None
     name: str = "mesh"
     normals: np.ndarray | None = None
+    alpha: object = None  # core/bake/alpha.SoupAlpha | None
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=np.float64).reshape(-1, 3, 3)

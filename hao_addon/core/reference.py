@@ -60,6 +60,30 @@ def first_hit(ray_cast, origin: Vector, direction: np.ndarray, reach: float, off
     return np.inf
 
 
+def hits_along(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
+               face_normals: np.ndarray | None, opaque, limit: int = 256) -> list[tuple[float, int, np.ndarray]]:
+    """Every surface along `direction` from `origin` within `reach`, nearest first, up to the
+    first one opaque(face index, hit point) says stops the ray: (distance, face index, hit
+    point (3,)); back faces skipped as first_hit skips them."""
+    dv = Vector(direction)
+    o = origin
+    travelled = 0.0
+    out = []
+    for _ in range(limit):
+        loc, _n, idx, dist = ray_cast(o, dv, reach - travelled)
+        if loc is None:
+            break
+        travelled += dist
+        o = loc + dv * offset
+        if face_normals is not None and float(face_normals[idx] @ direction) > 0.0:
+            continue
+        point = np.array(loc[:])
+        out.append((travelled, idx, point))
+        if opaque(idx, point):
+            break
+    return out
+
+
 def ray_offset(point: np.ndarray, scene_radius: float) -> float:
     """How far a ray starts off the surface at `point` (3,): see the module docstring."""
     return 1e-6 * scene_radius + 1e-7 * float(np.abs(point).max())

@@ -454,20 +454,21 @@ class GatherBaker(LightViewBaker):
         view = self.view(index)
         with util.scoped_state():
             gpu.state.blend_set('NONE')
+            alpha = self._alpha(index)
             if self.layered:  # every surface on the way counts: all faces into the lists
                 layers_prepass(self.layers_fb, self.all_batch, view, 'FRONT' if plan.settings.ignore_back_faces
-                               else 'NONE', self.layer_count, self.layer_depth, self.overflow)
+                               else 'NONE', self.layer_count, self.layer_depth, self.overflow, alpha)
             else:
                 culling, runs = self._depth_map_faces(index)
                 facing = None
-                if culling != 'NONE' and NORMAL_BINNING:  # faces turned towards ('BACK') or away from the light
+                if culling != 'NONE' and NORMAL_BINNING and alpha is None:  # faces turned towards ('BACK') or away from the light
                     toward = view.omega if culling == 'BACK' else -view.omega
                     facing = (self.facing_batch, self.face_bins.runs(toward))
                     drawn = sum(end - first for first, end in facing[1])
                     self.stats["depth_faces_drawn"] += drawn
                     self.stats["depth_faces_skipped"] += len(self.face_bins.order) - drawn
                 depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing,
-                              positions_only=True)
+                              positions_only=True, alpha=alpha)
         self.pending.append(view)
         if len(self.pending) == self.slots or index == plan.settings.directions - 1:
             self._test_pending_views()

@@ -153,11 +153,12 @@ class ScatterBaker(LightViewBaker):
         prepass_culling = 'FRONT' if plan.depth_map_culls_back_faces else 'NONE'
         with util.scoped_state():
             gpu.state.blend_set('NONE')
+            alpha = self._alpha(index)
             if self.layered:
                 layers_prepass(self.splat_fb, self.all_batch, view, culling, self.layer_count, self.layer_depth,
-                               self.overflow)
+                               self.overflow, alpha)
             else:
-                depth_prepass(self.depth_fb, self.all_batch, view, prepass_culling)
+                depth_prepass(self.depth_fb, self.all_batch, view, prepass_culling, alpha=alpha)
             with self.splat_fb.bind():
                 # Target faces turned away from the light add nothing (cos <= 0, or with shading
                 # normals a terminator direction, carried by above_fraction: bake_splat.frag):

@@ -59,7 +59,8 @@ def layers_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_layers", LAYERS), _layers_info)
 
 
-def layers_prepass(framebuffer, batch, view: OrthoView, culling: str, count, depth, overflow) -> None:
+def layers_prepass(framebuffer, batch, view: OrthoView, culling: str, count, depth, overflow,
+                   alpha: tuple[AlphaPass, int] | None = None) -> None:
     """The depth of every fragment of `batch` into per-pixel lists (count (side, side) and
     depth (side, side, LAYERS) R32UI images; overflow counts pixels with more than LAYERS):
     what max-distance bakes search for the occluder nearest to a receiver. Call inside
@@ -67,8 +68,10 @@ def layers_prepass(framebuffer, batch, view: OrthoView, culling: str, count, dep
     count.clear(format='UINT', value=(0,))
     with framebuffer.bind():
         util.set_overlay_pass_state(view.width, view.height, culling)
-        shader = layers_shader()
+        shader = layers_shader() if alpha is None else alpha_shader(layered=True)
         bind_light_view(shader, view, 0, prepass=True)
+        if alpha is not None:  # batch: an alpha_batch; alpha: (its pass, the direction's seed)
+            alpha[0].bind(shader, alpha[1])
         shader.image("layer_count", count)
         shader.image("layer_depth", depth)
         shader.image("overflow", overflow)
@@ -99,6 +102,70 @@ def _depth_positions_info() -> "gpu.types.GPUShaderCreateInfo":
 def depth_positions_shader() -> "gpu.types.GPUShader":
     """Depth-only drawing of a positions_batch."""
     return cached_shader(("bake_depth_positions",), _depth_positions_info)
+
+
+def _alpha_info(fragment: str, layered: bool) -> "gpu.types.GPUShaderCreateInfo":
+    """A depth (or, layered, depth-list) pass over an alpha_batch: fragments that the light
+    passes (core/bake/alpha.py) are left out."""
+    iface = gpu.types.GPUStageInterfaceInfo("hao_bake_alpha_iface")
+    iface.smooth('VEC2', "alpha_uv_v")
+    iface.flat('VEC2', "alpha_face_v")
+    info = gpu.types.GPUShaderCreateInfo()
+    info.vertex_in(0, 'VEC3', "pos")
+    info.vertex_in(1, 'VEC2', "alpha_uv")
+    info.vertex_in(2, 'VEC2', "alpha_face")
+    info.vertex_out(iface)
+    info.push_constant('MAT4', "view_proj")
+    info.push_constant('FLOAT', "alpha_seed")
+    info.push_constant('FLOAT', "alpha_clip")
+    info.sampler(0, 'FLOAT_2D_ARRAY', "alpha_tex")
+    info.fragment_out(0, 'FLOAT', "dummy_out")
+    info.define("ALPHA")
+    if layered:
+        info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
+        info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+        info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
+        info.define("LAYERS", str(LAYERS))
+    info.vertex_source(glsl_source("bake_alpha.vert"))
+    info.fragment_source(glsl_source("bake_alpha.glsl", fragment))
+    return info
+
+
+def alpha_shader(layered: bool) -> "gpu.types.GPUShader":
+    """The depth pass (or, layered, the depth-list pass) that leaves out what the light passes."""
+    if layered:
+        return cached_shader(("bake_layers_alpha", LAYERS), lambda: _alpha_info("bake_layers.frag", True))
+    return cached_shader(("bake_depth_alpha",), lambda: _alpha_info("bake_depth.frag", False))
+
+
+def alpha_batch(plan: BakePlan) -> "gpu.types.GPUBatch":
+    """Everything the light views draw (plan.drawn_positions) with each face's alpha: its UVs
+    and (constant alpha, image layer) per corner (plan.alpha)."""
+    alpha = plan.alpha
+    face = np.stack([alpha.constant, alpha.layer.astype(np.float32)], axis=1)
+    return util.make_batch('TRIS', {"pos": ('F32', plan.drawn_positions.reshape(-1, 3)),
+                                    "alpha_uv": ('F32', alpha.uvs.reshape(-1, 2)),
+                                    "alpha_face": ('F32', np.repeat(face, 3, axis=0))})
+
+
+class AlphaPass:
+    """The GPU side of plan.alpha: its images as one array texture, bound with a direction's
+    seed to the depth passes."""
+
+    def __init__(self, plan: BakePlan) -> None:
+        alpha = plan.alpha
+        layers, side = alpha.images.shape[0], alpha.images.shape[1]
+        data = gpu.types.Buffer('FLOAT', layers * side * side, np.ascontiguousarray(alpha.images, np.float32).ravel())
+        self.texture = gpu.types.GPUTexture((side, side), layers=layers, format='R32F', data=data)
+        self.clip = alpha.clip if alpha.mode == "clip" else -1.0
+
+    def bind(self, shader, seed: int) -> None:
+        shader.uniform_sampler("alpha_tex", self.texture)
+        shader.uniform_float("alpha_seed", float(seed))
+        shader.uniform_float("alpha_clip", float(self.clip))
+
+    def free(self) -> None:
+        self.texture = None
 
 
 def positions_batch(positions: np.ndarray) -> "gpu.types.GPUBatch":
@@ -155,7 +222,8 @@ def bind_light_view(shader, view: OrthoView, map_size: int, prepass: bool = Fals
 
 
 def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
-                  averted_runs: list[tuple[int, int]] = (), facing=None, positions_only: bool = False) -> None:
+                  averted_runs: list[tuple[int, int]] = (), facing=None, positions_only: bool = False,
+                  alpha: tuple[AlphaPass, int] | None = None) -> None:
     """Clear the view's sub-rectangle and draw `batch` depth-only from the light (a
     positions_batch where positions_only, else a plan_batch: its attributes only cost).
 
@@ -169,6 +237,8 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
     all.) Call inside util.scoped_state()."""
     w, h = view.width, view.height
     shader = depth_positions_shader() if positions_only else depth_shader()
+    if alpha is not None:  # batch: an alpha_batch (no facing runs); alpha: (its pass, the direction's seed)
+        shader = alpha_shader(layered=False)
     with framebuffer.bind():
         fb = gpu.state.active_framebuffer_get()
         gpu.state.viewport_set(0, 0, w, h)
@@ -182,6 +252,8 @@ def depth_prepass(framebuffer, batch, view: OrthoView, culling: str,
         gpu.state.color_mask_set(False, False, False, False)
         if facing is None:
             bind_light_view(shader, view, 0, prepass=True)
+            if alpha is not None:
+                alpha[0].bind(shader, alpha[1])
             batch.draw(shader)
         else:
             positions_shader = depth_positions_shader()
@@ -234,8 +306,14 @@ class LightViewBaker(util.GPUPass):
         self._views: dict[int, OrthoView] = {}
         # Direction of each step (run_direction(step)); subclasses may reorder.
         self.direction_order = np.arange(plan.settings.directions)
+        self.alpha_pass = None
         try:
-            self.all_batch = self._light_view_batch(self._draw_order())
+            order = self._draw_order()
+            if plan.alpha is not None:  # what lets light through: every face, with its alpha (no holes: in order)
+                self.alpha_pass = AlphaPass(plan)
+                self.all_batch = alpha_batch(plan)
+            else:
+                self.all_batch = self._light_view_batch(order)
             self.target_batch = self._target_batch()
             self._allocate()
         except BaseException:
@@ -250,6 +328,15 @@ class LightViewBaker(util.GPUPass):
         """What the light views draw (all_batch): target and occluders with their raster
         attributes (plan_batch), in `order`."""
         return plan_batch(self.plan, with_occluders=True, order=order)
+
+    def _alpha(self, index: int) -> tuple[AlphaPass, int] | None:
+        """What the depth passes of direction `index` need to leave out what the light passes
+        (None where nothing lets light through: the plain passes, counted)."""
+        if self.plan.alpha is None:
+            self.stats["alpha_passes_skipped"] = self.stats.get("alpha_passes_skipped", 0) + 1
+            return None
+        self.stats["alpha_passes"] = self.stats.get("alpha_passes", 0) + 1
+        return self.alpha_pass, index
 
     def _target_batch(self) -> "gpu.types.GPUBatch":
         return plan_batch(self.plan, with_occluders=False)
@@ -274,3 +361,6 @@ class LightViewBaker(util.GPUPass):
     def _release(self) -> None:
         """Subclasses drop their own textures and framebuffers, then call this."""
         self.all_batch = self.target_batch = None
+        if self.alpha_pass is not None:
+            self.alpha_pass.free()
+            self.alpha_pass = None

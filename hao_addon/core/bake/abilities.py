@@ -35,6 +35,7 @@ ABILITIES = (
     Ability("udim", "UDIM tiles", "UDIM tiles"),
     Ability("color-attribute", "Colour attribute", "a colour attribute"),
     Ability("thickness", "Thickness", "thickness"),
+    Ability("alpha", "Alpha occluders", "occluders that let light through"),
 )
 ABILITY_NAMES = tuple(a.name for a in ABILITIES)
 

@@ -17,6 +17,7 @@ from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
 from .abilities import abilities_needed, check_method, choose_method
+from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
@@ -89,6 +90,8 @@ class BakePlan:
     stats: dict = field(default_factory=dict)
     # The target's kind (core/bake/target_kinds.py): texels, corners or projected points.
     kind: TargetKind = TARGET_KINDS["texels"]
+    # What lets light through, per drawn face (core/bake/alpha.py), or None: all opaque.
+    alpha: DrawnAlpha | None = None
 
     def receivers(self) -> Receivers:
         """The bake's receivers: the projected high-poly points, the target's face corners
@@ -116,7 +119,8 @@ class BakePlan:
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
         settings = self.settings
-        return abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None)
+        needs = abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None)
+        return needs | {"alpha"} if self.alpha is not None else needs
 
     def check_method(self, method: str) -> None:
         """Refuse `method` if it cannot bake this plan (core/bake/abilities.py)."""
@@ -278,10 +282,12 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     if settings.max_distance > 0.0 and occluders:
         lo_t, hi_t = column_bounds(flat)
     occ_parts, culled_objects, culled_faces, drawn_objects = [], 0, 0, 0
+    alpha_parts = [(target.face_count, None)] if kind.target_occludes else []  # drawn faces, in order
     for occ in occluders:
         if occ.face_count == 0:
             continue
         p = occ.positions
+        near = None
         if settings.max_distance > 0.0:
             # Per triangle: the gap between its box and the target's box.
             gap = np.maximum(0.0, np.maximum(p.min(axis=1) - hi_t, lo_t - p.max(axis=1)))
@@ -293,6 +299,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
             p = p[near]
         drawn_objects += 1
         occ_parts.append((p - centre) / scale)
+        alpha_parts.append((len(p), occ.alpha if occ.alpha is None or near is None else occ.alpha.subset(near)))
     o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
     o_normals, _ = face_normals_areas(o_pos)
 
@@ -320,8 +327,10 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     drawn = np.concatenate(drawn_parts)
     target_weld = weld(t_pos.reshape(-1, 3))
     # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
+    alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
     holes = None
-    if settings.max_distance == 0.0 and not settings.ignore_back_faces:
+    # Through surfaces that let light through, every face on a ray counts: no culling of one side.
+    if settings.max_distance == 0.0 and not settings.ignore_back_faces and alpha is None:
         # Without occluders the drawn corners are the target's: one weld serves both.
         holes = surface_holes(drawn.reshape(-1, 3, 3), target_weld if len(o_pos) == 0 else None)
     closed = holes == []
@@ -343,7 +352,9 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                  occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
                  dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
                  holes=-1 if holes is None else len(holes), smooth_corners=smooth_corners,
-                 samples_per_texel=settings.sample_count, warnings=uv_warnings, **uv_counters, **projection_stats)
+                 samples_per_texel=settings.sample_count, warnings=uv_warnings,
+                 alpha_faces=0 if alpha is None else int(((alpha.constant < 1.0) | (alpha.layer >= 0)).sum()),
+                 **uv_counters, **projection_stats)
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
     return BakePlan(settings, centre, scale, t_pos.astype(np.float32), uvs.astype(np.float32),
                     np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
@@ -351,7 +362,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, vertex_target, udim, stats, kind)
+                    closed, holes, projected, vertex_target, udim, stats, kind, alpha)
 
 
 def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:

@@ -25,7 +25,9 @@ from .estimators import texel_sums
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from .terminator import lift_amount
-from ..reference import build_bvh, first_hit, ray_offset
+from ..reference import build_bvh, first_hit, hits_along, ray_offset
+from .alpha import expected_visibility
+from .projection import barycentric
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
 # minutes, which nobody asks for by accident.
@@ -66,6 +68,7 @@ class ReferenceBaker:
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
         self.geometric = receivers.geometric
         scene = plan.drawn_positions.astype(np.float64)
+        self.scene = scene
         self.bvh = build_bvh(scene)
         self.face_normals = plan.drawn_normals.astype(np.float64) if plan.settings.ignore_back_faces else None
         flat = scene.reshape(-1, 3)
@@ -96,19 +99,39 @@ class ReferenceBaker:
             lifted = (weight > 0.0) & (amount * np.linalg.norm(self.lift, axis=1) > self.offsets)
         else:
             lifted = np.zeros(len(self.points), bool)
-        for i in np.flatnonzero(above & (weight > 0.0) & ~lifted):
-            dists[i] = first_hit(ray_cast, self.origins[i], omega, reach, self.offsets[i], self.face_normals)
-        for i in np.flatnonzero(lifted):
-            origin = Vector(self.points[i] + self.lift[i] * amount[i])
-            dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals)
-        visible = 1.0 - occlusion_weight(dists, self.plan.max_distance_normalized if settings.max_distance > 0.0
-                                         else 0.0, settings.falloff)
+        d_max = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 0.0
+        starts = [(i, self.origins[i]) for i in np.flatnonzero(above & (weight > 0.0) & ~lifted)]
+        starts += [(i, Vector(self.points[i] + self.lift[i] * amount[i])) for i in np.flatnonzero(lifted)]
+        if self.plan.alpha is None:
+            for i, origin in starts:
+                dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals)
+            visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)
+        else:  # every surface up to the first opaque one, each kept with its alpha (core/bake/alpha.py)
+            visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)  # 0 below the surface
+            for i, origin in starts:
+                visible[i] = self._visible_through(origin, omega, reach, self.offsets[i], d_max)
         self.sums += self.estimator.terms(weight, visible, omega)
         traced = (above & (weight > 0.0)) | lifted
         self.stats["rays_traced"] += int(traced.sum())
         self.stats["rays_lifted"] += int(lifted.sum())
         self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above & ~lifted).sum())
         self.stats["directions_done"] += 1
+
+    def _visible_through(self, origin: Vector, omega: np.ndarray, reach: float, offset: float, d_max: float
+                         ) -> float:
+        """A ray's expected visibility through surfaces that let light through."""
+        alpha, settings = self.plan.alpha, self.plan.settings
+        kept_of = {}
+
+        def opaque(face: int, point: np.ndarray) -> bool:
+            bary = barycentric(point[None], self.scene[face][None])
+            kept_of[face, tuple(point)] = float(alpha.kept_weight(alpha.face_alpha(np.array([face]), bary))[0])
+            return kept_of[face, tuple(point)] >= 1.0
+
+        hits = hits_along(self.bvh.ray_cast, origin, omega, reach, offset, self.face_normals, opaque)
+        kept = [kept_of[face, tuple(point)] for _d, face, point in hits]
+        occlusion = occlusion_weight(np.array([d for d, _f, _p in hits]), d_max, settings.falloff)
+        return expected_visibility(kept, list(occlusion))
 
     def accumulated(self) -> np.ndarray:
         """(*plan.output_shape, channels) float64: the estimator's sums per texel (or element)."""

@@ -41,6 +41,11 @@ TERMINATOR_CHOICES = (
                                  "none (OBJ, glTF)"),
     Choice("setting", "Terminator Offset", "the Terminator Offset setting for every object"),
 )
+ALPHA_CHOICES = (
+    Choice("blend", "Blend", "an occluder stops light as much as its material's alpha (a 50 % leaf card half)"),
+    Choice("clip", "Clip", "an occluder stops light where its alpha reaches Alpha Clip, elsewhere none (cut-outs)"),
+    Choice("off", "Off", "every occluder is opaque, whatever its material"),
+)
 TARGET_CHOICES = (
     Choice("image", "Image Textures", "an AO map in the UV layout"),
     Choice("color-attribute", "Color Attribute", "AO per vertex (or face corner) into the mesh's colour attribute "
@@ -110,6 +115,13 @@ class BakeSettings:
         False, label="Bent Normals", cli=None, cli_via="--bent-normal-out FILE",
         description="also bake the bent normal: each texel's cosine-weighted mean unoccluded direction, from "
                     "the same directions as the AO (gather and reference; the scatter cannot)")
+    alpha: str = setting(
+        "blend", label="Alpha", noun="alpha mode", choices=ALPHA_CHOICES,
+        description="how an occluder's material alpha (the Principled BSDF's Alpha: a value, or an Image Texture's "
+                    "alpha on the mesh's UVs) lets light through")
+    alpha_clip: float = setting(
+        0.5, label="Alpha Clip", minimum=0.0, maximum=1.0,
+        description="Alpha 'clip': an occluder's surface stops light where its alpha is at least this")
     thickness: bool = setting(
         False, label="Thickness", cli=None, cli_via="--thickness-out FILE",
         description="also bake thickness (Substance's): the occlusion of the inverted hemisphere, seen from inside "
