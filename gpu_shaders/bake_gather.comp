@@ -43,6 +43,17 @@ vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
   return vec3(px, min(plane_depth, depth) - slack);
 }
 
+/* The depth of the receiver's plane at the centre of the pixel `position` falls in. */
+float receiver_plane_depth(int k, vec3 position, vec3 plane_normal)
+{
+  vec3 light_pos = (views.view_proj[k] * vec4(position, 1.0)).xyz;
+  vec2 at = (light_pos.xy * 0.5 + 0.5) * views.view_info[k].xy;
+  vec3 m = mat3(views.view_proj[k]) * plane_normal;
+  float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
+  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
+  return light_pos.z * 0.5 + 0.5 + dot(slope, floor(at) + 0.5 - at);
+}
+
 #ifndef MAX_DISTANCE
 /* Visibility of `position` (on a plane of normal plane_normal) from view k. */
 float visible_from(sampler2D depth_tex, int k, vec3 position, vec3 plane_normal, float slope_slack)
@@ -71,14 +82,17 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
   }
   ivec2 px = ivec2(lookup.xy);
   int count = min(int(imageLoad(layer_count, px).r), LAYERS);
+  float depth = (views.view_proj[k] * vec4(position, 1.0)).z * 0.5 + 0.5;
+  /* min_distance: nearer occluders are passed by. Measured from the receiver's plane at the
+   * pixel centre, where the listed depths are (a ray there is as long as the receiver's). */
+  float from_depth = receiver_plane_depth(k, position, plane_normal) - min_distance / views.view_info[k].w;
   float z_front = -1.0;
   for (int i = 0; i < count; i++) {
     float z = uintBitsToFloat(imageLoad(layer_depth, ivec3(px, i)).r);
-    if (z < lookup.z && z > z_front) {
+    if (z < lookup.z && z > z_front && z <= from_depth) {
       z_front = z;
     }
   }
-  float depth = (views.view_proj[k] * vec4(position, 1.0)).z * 0.5 + 0.5;
   return (z_front >= 0.0) ? occluder_visibility((depth - z_front) * views.view_info[k].w, max_distance) : 1.0;
 }
 #  define VISIBLE_AT(depth_tex, k, origin, plane_normal, slope_slack) \
@@ -91,9 +105,14 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
 
 /* Hemisphere weight of a light at cos_theta > 0 (times the entry's scale, added in GATHER_VIEW). */
 #ifdef UNIFORM_WEIGHTING
-#  define VIEW_WEIGHT(cos_theta) 1.0
+#  define HEMISPHERE_WEIGHT(cos_theta) 1.0
 #else
-#  define VIEW_WEIGHT(cos_theta) (cos_theta)
+#  define HEMISPHERE_WEIGHT(cos_theta) (cos_theta)
+#endif
+#ifdef SPREAD_COS /* outside the spread cone: weighs nothing */
+#  define VIEW_WEIGHT(cos_theta) (HEMISPHERE_WEIGHT(cos_theta) * step(SPREAD_COS, (cos_theta)))
+#else
+#  define VIEW_WEIGHT(cos_theta) HEMISPHERE_WEIGHT(cos_theta)
 #endif
 
 /* Adds one view's term to sum when the entry faces that light. With shading normals the

@@ -30,6 +30,9 @@ void main()
 #else
   float weight = jacobian * cos_theta * face_data.w;
 #endif
+#ifdef SPREAD_COS
+  weight *= step(SPREAD_COS, cos_theta); /* outside the spread cone: weighs nothing */
+#endif
 #ifdef MAX_DISTANCE
   /* The nearest occluder in front of this fragment: the largest listed depth below its own
    * (its own entry is equal and excluded by the tolerance). Depth is linear in an
@@ -40,7 +43,8 @@ void main()
   float z_front = -1.0;
   for (int i = 0; i < count; i++) {
     float z = uintBitsToFloat(imageLoad(layer_depth, ivec3(px, i)).r);
-    if (z < z_self - depth_tolerance && z > z_front) {
+    /* min_distance: nearer occluders are passed by */
+    if (z < z_self - depth_tolerance && z > z_front && (z_self - z) * depth_span >= min_distance) {
       z_front = z;
     }
   }

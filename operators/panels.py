@@ -29,6 +29,8 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.active = settings.max_distance > 0.0
         sub.prop(settings, "falloff")
         col.prop(settings, "weighting")
+        col.prop(settings, "spread_angle")
+        col.prop(settings, "min_distance")
         col.prop(settings, "normals")
         sub = col.column()
         sub.active = settings.normals == 'mesh'

@@ -45,6 +45,15 @@ def plan_needing(ability: str, method: str):
         verts, index = np.unique(points.round(9), axis=0, return_inverse=True)
         return make_plan(TriangleSoup(plane.positions, None, "plane"), [], BakeSettings(target="color-attribute", **kw),
                          vertex_target=indexed_vertex_target(index.reshape(-1, 3), len(verts)))
+    if ability == "min-distance":
+        return make_plan(plane, [], BakeSettings(min_distance=0.5, **kw))
+    if ability == "spread":
+        return make_plan(plane, [], BakeSettings(spread_angle=60.0, **kw))
+    if ability == "alpha":
+        from hao_addon.core.bake.alpha import SoupAlpha
+        card = scenes.grid_plane(2.0, 2, z=0.5, name="card")
+        card = TriangleSoup(card.positions, None, "card", alpha=SoupAlpha(np.full(card.face_count, 0.5, np.float32)))
+        return make_plan(plane, [card], BakeSettings(**kw))
     if ability == "thickness":  # a need of thickness_steps (tests/test_thickness.py), not of a plan
         check_method(method, frozenset({"max-distance", "thickness"}))
         return make_plan(plane, [], BakeSettings(max_distance=1.0, **kw))
@@ -84,7 +93,7 @@ def test_auto_takes_the_scatter_for_a_max_distance_alone_otherwise_the_gather():
     """Auto's rule as the benchmark set it, over every combination of needs: the scatter for
     a max distance alone, the gather otherwise; thickness, which the gather declares it
     cannot bake, with the scatter where it can bake the rest, else refused."""
-    scatter_can = {"max-distance", "thickness"}
+    scatter_can = {"max-distance", "thickness", "min-distance", "spread", "alpha"}
     for k in range(len(ABILITY_NAMES) + 1):
         for needs in map(frozenset, itertools.combinations(ABILITY_NAMES, k)):
             assert choose_method("reference", needs) == "reference"
@@ -92,8 +101,8 @@ def test_auto_takes_the_scatter_for_a_max_distance_alone_otherwise_the_gather():
                 with pytest.raises(BakeInputError, match="no GPU baker can bake"):
                     choose_method("auto", needs)
                 continue
-            expected = "scatter" if needs in ({"max-distance"}, {"thickness"}, scatter_can) else "gather"
-            assert choose_method("auto", needs) == expected, needs
+            by_scatter = needs <= scatter_can and ("max-distance" in needs or "thickness" in needs)
+            assert choose_method("auto", needs) == ("scatter" if by_scatter else "gather"), needs
 
 
 def test_settings_choose_through_the_declarations():

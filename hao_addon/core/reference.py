@@ -41,10 +41,10 @@ def uniform_hemisphere(count: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def first_hit(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
-              face_normals: np.ndarray | None) -> float:
+              face_normals: np.ndarray | None, min_distance: float = 0.0) -> float:
     """Distance along `direction` (3,) from `origin` to the first hit within `reach` (inf if
     none); faces whose normal points along the ray (seen from behind) are skipped when
-    face_normals (F, 3) is given (back faces ignored)."""
+    face_normals (F, 3) is given (back faces ignored), and hits nearer than min_distance."""
     dv = Vector(direction)
     o = origin
     travelled = 0.0
@@ -53,15 +53,16 @@ def first_hit(ray_cast, origin: Vector, direction: np.ndarray, reach: float, off
         if loc is None:
             return np.inf
         travelled += dist
-        if face_normals is not None and float(face_normals[idx] @ direction) > 0.0:
-            o = loc + dv * offset  # a back face: skip it and continue
+        if (face_normals is not None and float(face_normals[idx] @ direction) > 0.0) or travelled < min_distance:
+            o = loc + dv * offset  # a back face, or too near: skip it and continue
             continue
         return travelled
     return np.inf
 
 
 def hits_along(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
-               face_normals: np.ndarray | None, opaque, limit: int = 256) -> list[tuple[float, int, np.ndarray]]:
+               face_normals: np.ndarray | None, opaque, limit: int = 256,
+               min_distance: float = 0.0) -> list[tuple[float, int, np.ndarray]]:
     """Every surface along `direction` from `origin` within `reach`, nearest first, up to the
     first one opaque(face index, hit point) says stops the ray: (distance, face index, hit
     point (3,)); back faces skipped as first_hit skips them."""
@@ -75,7 +76,7 @@ def hits_along(ray_cast, origin: Vector, direction: np.ndarray, reach: float, of
             break
         travelled += dist
         o = loc + dv * offset
-        if face_normals is not None and float(face_normals[idx] @ direction) > 0.0:
+        if (face_normals is not None and float(face_normals[idx] @ direction) > 0.0) or travelled < min_distance:
             continue
         point = np.array(loc[:])
         out.append((travelled, idx, point))

@@ -162,7 +162,7 @@ def views_per_dispatch(plan: BakePlan) -> int:
     Max-distance bakes test one direction per dispatch (each needs its per-pixel depth
     lists, LAYERS deep, which are too large to keep several of)."""
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
-    if plan.settings.max_distance > 0.0:
+    if plan.layered:
         return 1
     most = int(np.clip(DEPTH_BATCH_BYTES // (4 * plan.max_view_side**2), 1, VIEWS_PER_DISPATCH))
     directions = max(1, plan.settings.directions)
@@ -179,7 +179,7 @@ ACCUM_BINDINGS = (2, 6)
 
 
 def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool,
-                 estimator: Estimator) -> "gpu.types.GPUShaderCreateInfo":
+                 estimator: Estimator, spread_cos: float = 0.0) -> "gpu.types.GPUShaderCreateInfo":
     """falloff: None for unlimited distance (depth maps), else the max-distance falloff
     ('none', 'wendland'), tested against per-pixel depth lists; terminator: entries carry
     their terminator lift (image entry_lift); estimator: what each direction adds."""
@@ -203,6 +203,8 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
     info.define("SLOPE_BIAS_PIXELS", repr(float(SLOPE_BIAS_PIXELS)))
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
+    if spread_cos > 0.0:
+        info.define("SPREAD_COS", repr(float(spread_cos)))
     info.push_constant('INT', "first_entry")
     info.push_constant('INT', "entry_end")
     info.typedef_source(glsl_source("bake_gather_views.glsl"))
@@ -223,18 +225,20 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         info.image(3, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ'})
         info.image(4, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ'})
         info.push_constant('FLOAT', "max_distance")
+        info.push_constant('FLOAT', "min_distance")
     info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_terminator.glsl",
                                     "bake_estimator.glsl", "bake_gather.comp"))
     return info
 
 
 def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
-                  terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION) -> "gpu.types.GPUShader":
+                  terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION,
+                  spread_cos: float = 0.0) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to GATHER_MAX_VIEWS) directions per dispatch; shading:
     entries carry shading normals (plan.smooth_shading); falloff, terminator, estimator: see
-    _gather_info."""
-    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator, estimator.define),
-                         lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator))
+    _gather_info; spread_cos: the spread cone's cut-off (0: the hemisphere)."""
+    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator, estimator.define, spread_cos),
+                         lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator, spread_cos))
 
 
 class GatherBaker(LightViewBaker):
@@ -248,14 +252,14 @@ class GatherBaker(LightViewBaker):
         the UV-space target of the list pass, and the view depth."""
         side = plan.max_view_side
         entries = plan.settings.size**2 * plan.settings.sample_count
-        per_pixel = 1 + (4 + 4 * LAYERS if plan.settings.max_distance > 0.0 else 4 * views_per_dispatch(plan))
+        per_pixel = 1 + (4 + 4 * LAYERS if plan.layered else 4 * views_per_dispatch(plan))
         return entries * (entry_bytes(plan) + 1) + side * side * per_pixel
 
     def _allocate(self) -> None:
         plan = self.plan
         side = plan.max_view_side
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
-        self.layered = plan.settings.max_distance > 0.0
+        self.layered = plan.layered
         self.slots = views_per_dispatch(plan)
         if self.layered:
             # Max distance: the occluder nearest to each receiver, from per-pixel depth lists.
@@ -307,7 +311,7 @@ class GatherBaker(LightViewBaker):
         """Depth maps need the positions alone (a plan_batch's other attributes made llvmpipe
         set up their interpolation for every averted face drawn); depth lists (max distance)
         the plan_batch."""
-        if self.plan.settings.max_distance > 0.0:
+        if self.plan.layered:
             return super()._light_view_batch(order)
         positions = self.plan.drawn_positions
         return positions_batch(positions if order is None else positions[order])
@@ -513,13 +517,15 @@ class GatherBaker(LightViewBaker):
         settings = self.plan.settings
         # One variant per bake: a last, short batch fills the other slots with padding (omega 0).
         shader = gather_shader(settings.weighting == "uniform", self.slots, self.shading_layout,
-                               settings.falloff if self.layered else None, self.lifted, self.plan.estimator)
+                               self.plan.layered_falloff if self.layered else None, self.lifted, self.plan.estimator,
+                               settings.spread_cos)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         if self.layered:
             shader.image("layer_count", self.layer_count)
             shader.image("layer_depth", self.layer_depth)
-            shader.uniform_float("max_distance", self.plan.max_distance_normalized)
+            shader.uniform_float("max_distance", self.plan.layered_reach)
+            shader.uniform_float("min_distance", self.plan.min_distance_normalized)
         else:
             for k in range(self.slots):
                 shader.uniform_sampler(f"depth_tex{k}", self.depths[k])

@@ -44,7 +44,7 @@ MAX_FOOTPRINT = 8
 
 
 def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
-                shading: bool) -> "gpu.types.GPUShaderCreateInfo":
+                shading: bool, spread_cos: float = 0.0) -> "gpu.types.GPUShaderCreateInfo":
     info = soup_shader_info("bake_splat", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
     if shading:
         info.define("SHADING_NORMALS", "1")
@@ -57,6 +57,7 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
         info.image(2, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
         info.push_constant('FLOAT', "depth_span")
         info.push_constant('FLOAT', "max_distance")
+        info.push_constant('FLOAT', "min_distance")
         info.define("MAX_DISTANCE", "1")
         info.define("LAYERS", str(LAYERS))
         if wendland:
@@ -65,16 +66,19 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
         info.sampler(0, 'FLOAT_2D', "depth_tex")
     if uniform:
         info.define("UNIFORM_WEIGHTING", "1")
+    if spread_cos > 0.0:
+        info.define("SPREAD_COS", repr(float(spread_cos)))
     info.fragment_source("layout(early_fragment_tests) in;\n" + glsl_source("bake_common.glsl", "bake_falloff.glsl",
                                                                             "bake_splat.frag"))
     return info
 
 
 def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
-                 shading: bool = False) -> "gpu.types.GPUShader":
-    """shading: weight by interpolated shading normals, with the terminator rule (plan.smooth_shading)."""
-    key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT, shading)
-    return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint, shading))
+                 shading: bool = False, spread_cos: float = 0.0) -> "gpu.types.GPUShader":
+    """shading: weight by interpolated shading normals, with the terminator rule (plan.smooth_shading);
+    spread_cos: the spread cone's cut-off (settings.spread_cos; 0: the hemisphere, no variant)."""
+    key = ("bake_splat", uniform, layered, wendland, footprint and MAX_FOOTPRINT, shading, spread_cos)
+    return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint, shading, spread_cos))
 
 
 class ScatterBaker(LightViewBaker):
@@ -97,7 +101,7 @@ class ScatterBaker(LightViewBaker):
         """The packed accumulator, the view depth and a dummy colour, and for max-distance
         bakes the per-pixel layer lists."""
         side = plan.max_view_side
-        layered = plan.settings.max_distance > 0.0
+        layered = plan.layered
         per_pixel = 4 + 4 + (4 + 4 * LAYERS if layered else 0)
         return plan.settings.size**2 * 4 + side * side * per_pixel
 
@@ -106,7 +110,7 @@ class ScatterBaker(LightViewBaker):
         settings = plan.settings
         size = settings.size
         side = plan.max_view_side
-        self.layered = settings.max_distance > 0.0
+        self.layered = plan.layered
         self.accum = gpu.types.GPUTexture((size, size), format='R32UI')
         self.accum.clear(format='UINT', value=(0,))
         self.dummy = gpu.types.GPUTexture((side, side), format='R8')
@@ -123,8 +127,8 @@ class ScatterBaker(LightViewBaker):
             self.depth_fb = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self.dummy)
             self.layer_count = self.layer_depth = self.overflow = None
         self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
-                                       settings.falloff == "wendland", plan.needs_footprint_splat,
-                                       plan.smooth_shading)
+                                       plan.layered_falloff == "wendland", plan.needs_footprint_splat,
+                                       plan.smooth_shading, settings.spread_cos)
         self.chunk = min(CHUNK_DIRECTIONS, settings.directions)
         self.fixed_scale = float(CHUNK_TARGET * settings.directions / (4.0 * self.chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
@@ -173,7 +177,8 @@ class ScatterBaker(LightViewBaker):
                     shader.image("layer_count", self.layer_count)
                     shader.image("layer_depth", self.layer_depth)
                     shader.uniform_float("depth_span", view.depth_far - view.depth_near)
-                    shader.uniform_float("max_distance", plan.max_distance_normalized)
+                    shader.uniform_float("max_distance", plan.layered_reach)
+                    shader.uniform_float("min_distance", plan.min_distance_normalized)
                 else:
                     shader.uniform_sampler("depth_tex", self.depth)
                 self.target_batch.draw(shader)

@@ -30,6 +30,8 @@ class Ability:
 
 ABILITIES = (
     Ability("max-distance", "Max distance, falloff", "a max distance"),
+    Ability("min-distance", "Min distance", "a min distance"),
+    Ability("spread", "Spread angle", "a spread angle"),
     Ability("selected-to-active", "Selected to Active", "Selected to Active"),
     Ability("bent-normals", "Bent normals", "bent normals"),
     Ability("udim", "UDIM tiles", "UDIM tiles"),
@@ -94,10 +96,11 @@ def bakers_with(*abilities: str, gpu_only: bool = False) -> list[str]:
 
 
 def abilities_needed(max_distance: float, bent_normals: bool, target_kind: TargetKind,
-                     tiled: bool) -> frozenset[str]:
+                     tiled: bool, min_distance: float = 0.0, spread: bool = False) -> frozenset[str]:
     """The abilities a bake with these settings, this kind of target (its row's ability:
     Selected to Active, a colour attribute) and, where tiled, a UV layout on UDIM tiles needs."""
-    asked = {"max-distance": max_distance > 0.0, "bent-normals": bent_normals, "udim": tiled}
+    asked = {"max-distance": max_distance > 0.0, "bent-normals": bent_normals, "udim": tiled,
+             "min-distance": min_distance > 0.0, "spread": spread}
     needed = {name for name, wanted in asked.items() if wanted}
     return frozenset(needed | ({target_kind.ability} if target_kind.ability else set()))
 

@@ -19,17 +19,21 @@ import numpy as np
 WEIGHTINGS = ("cosine", "uniform")
 
 
-def hemisphere_weight(cos_theta: np.ndarray, weighting: str) -> np.ndarray:
-    """Per-direction weight of the estimator for cos(theta) = w . n."""
+def hemisphere_weight(cos_theta: np.ndarray, weighting: str, spread_cos: float = 0.0) -> np.ndarray:
+    """Per-direction weight of the estimator for cos(theta) = w . n; directions outside the
+    spread cone (cos(theta) < spread_cos, the cosine of the Spread Angle; 0: the hemisphere)
+    weigh nothing."""
     if weighting == "cosine":
-        return np.maximum(cos_theta, 0.0)
-    if weighting == "uniform":
-        return (cos_theta > 0.0).astype(cos_theta.dtype)
-    raise ValueError(f"unknown weighting '{weighting}', expected one of {WEIGHTINGS}")
+        weight = np.maximum(cos_theta, 0.0)
+    elif weighting == "uniform":
+        weight = (cos_theta > 0.0).astype(np.asarray(cos_theta).dtype)
+    else:
+        raise ValueError(f"unknown weighting '{weighting}', expected one of {WEIGHTINGS}")
+    return weight if spread_cos <= 0.0 else np.where(cos_theta >= spread_cos, weight, 0.0).astype(weight.dtype)
 
 
 def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str = "cosine",
-                     chunk: int = 8192) -> np.ndarray:
+                     chunk: int = 8192, spread_cos: float = 0.0) -> np.ndarray:
     """S_f for each face.
 
     normals: (F, 3) unit face normals (zero rows for degenerate faces);
@@ -48,7 +52,9 @@ def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str
     out = np.empty(len(normals), dtype=np.float64)
     for start in range(0, len(normals), chunk):
         block = normals[start:start + chunk] @ dirs_t  # (chunk, D)
-        if weighting == "cosine":
+        if spread_cos > 0.0:
+            block = hemisphere_weight(block, weighting, spread_cos).astype(np.float32)
+        elif weighting == "cosine":
             np.maximum(block, 0.0, out=block)
         else:
             block = (block > 0.0).astype(np.float32)
@@ -57,7 +63,8 @@ def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str
 
 
 def corner_normalizers(shading: np.ndarray, face_normals: np.ndarray, directions: np.ndarray,
-                       weighting: str = "cosine", chunk: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+                       weighting: str = "cosine", chunk: int = 4096, spread_cos: float = 0.0
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """S and its above-face part at every corner of shaded faces.
 
     shading: (F, 3, 3) unit corner shading normals; face_normals: (F, 3) unit face normals;
@@ -77,7 +84,7 @@ def corner_normalizers(shading: np.ndarray, face_normals: np.ndarray, directions
         up = (faces[start:start + chunk] @ dirs_t) > 0.0  # (chunk, D)
         for k in range(3):
             block = shading[start:start + chunk, k] @ dirs_t
-            block = np.maximum(block, 0.0) if weighting == "cosine" else (block > 0.0).astype(np.float32)
+            block = hemisphere_weight(block, weighting, spread_cos).astype(np.float32)
             total[start:start + chunk, k] = block @ ones
             above[start:start + chunk, k] = np.where(up, block, 0.0) @ ones
     return total, above

@@ -119,7 +119,8 @@ class BakePlan:
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
         settings = self.settings
-        needs = abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None)
+        needs = abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None,
+                                 settings.min_distance, settings.spread_cos > 0.0)
         return needs | {"alpha"} if self.alpha is not None else needs
 
     def check_method(self, method: str) -> None:
@@ -170,11 +171,31 @@ class BakePlan:
         texels of a torus, each by at most one direction's term). With a max distance a face where a ray
         enters an occluder can lie within reach while its exit does not, so both stay. The
         gather uses `holes` instead (bake_gather.py)."""
-        return self.settings.ignore_back_faces or (self.closed_surfaces and self.settings.max_distance == 0.0)
+        return self.settings.ignore_back_faces or (self.closed_surfaces and not self.layered)
+
+    @property
+    def layered(self) -> bool:
+        """Whether the passes need every surface along a ray (per-pixel depth lists), not the
+        nearest one: with a max distance, or a min distance that rays go on past."""
+        return self.settings.max_distance > 0.0 or self.settings.min_distance > 0.0
 
     @property
     def max_distance_normalized(self) -> float:
         return self.settings.max_distance / self.scale
+
+    @property
+    def layered_reach(self) -> float:
+        """The depth lists' max distance, normalized: the setting's, or 1e30 when unlimited."""
+        return self.max_distance_normalized if self.settings.max_distance > 0.0 else 1e30
+
+    @property
+    def layered_falloff(self) -> str:
+        """The depth lists' falloff (none where the distance is unlimited: falloff needs one)."""
+        return self.settings.falloff if self.settings.max_distance > 0.0 else "none"
+
+    @property
+    def min_distance_normalized(self) -> float:
+        return self.settings.min_distance / self.scale
 
     def view(self, index: int) -> OrthoView:
         """The light view of direction `index`, with a deterministic sub-pixel jitter."""
@@ -257,7 +278,8 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     else:  # no UV layout: the light views are as fine as for a Size map over the bounding sphere
         uv_area, uv_warnings, uv_counters = None, [], {}
     # A method that cannot bake what is asked is refused before the projection's rays.
-    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None)
+    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
+                             settings.min_distance, settings.spread_cos > 0.0)
     check_method(choose_method(settings.method, needs), needs, asked_phrases(udim))
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
@@ -303,7 +325,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
     o_normals, _ = face_normals_areas(o_pos)
 
-    s_f = face_normalizers(normals, directions, settings.weighting)
+    s_f = face_normalizers(normals, directions, settings.weighting, spread_cos=settings.spread_cos)
     # Faces no direction sees, and zero-area faces (no surface), contribute nothing.
     inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
@@ -330,7 +352,8 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
     holes = None
     # Through surfaces that let light through, every face on a ray counts: no culling of one side.
-    if settings.max_distance == 0.0 and not settings.ignore_back_faces and alpha is None:
+    if settings.max_distance == 0.0 and settings.min_distance == 0.0 and not settings.ignore_back_faces \
+            and alpha is None:
         # Without occluders the drawn corners are the target's: one weld serves both.
         holes = surface_holes(drawn.reshape(-1, 3, 3), target_weld if len(o_pos) == 0 else None)
     closed = holes == []
@@ -433,7 +456,7 @@ def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarra
         out[..., :3] = normals[:, None, :]
         out[..., 3] = inv_s[:, None]
         return out, np.ones((len(normals), 3), np.float32), 0
-    s_c, above = corner_normalizers(shading, normals, directions, settings.weighting)
+    s_c, above = corner_normalizers(shading, normals, directions, settings.weighting, spread_cos=settings.spread_cos)
     lit = (s_c > 0.0) & (inv_s[:, None] > 0.0)
     out[..., :3] = shading
     out[..., 3] = np.divide(1.0, s_c, out=np.zeros_like(s_c), where=lit)

@@ -86,7 +86,7 @@ class ReferenceBaker:
         settings = self.plan.settings
         omega = self.plan.directions[index]
         cos_shading = self.shading @ omega
-        weight = hemisphere_weight(cos_shading, settings.weighting) * self.inv_s
+        weight = hemisphere_weight(cos_shading, settings.weighting, settings.spread_cos) * self.inv_s
         cos_true = self.geometric @ omega
         above = cos_true > 0.0
         reach = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 1e30
@@ -104,7 +104,8 @@ class ReferenceBaker:
         starts += [(i, Vector(self.points[i] + self.lift[i] * amount[i])) for i in np.flatnonzero(lifted)]
         if self.plan.alpha is None:
             for i, origin in starts:
-                dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals)
+                dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals,
+                                     self.plan.min_distance_normalized)
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)
         else:  # every surface up to the first opaque one, each kept with its alpha (core/bake/alpha.py)
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)  # 0 below the surface
@@ -128,7 +129,8 @@ class ReferenceBaker:
             kept_of[face, tuple(point)] = float(alpha.kept_weight(alpha.face_alpha(np.array([face]), bary))[0])
             return kept_of[face, tuple(point)] >= 1.0
 
-        hits = hits_along(self.bvh.ray_cast, origin, omega, reach, offset, self.face_normals, opaque)
+        hits = hits_along(self.bvh.ray_cast, origin, omega, reach, offset, self.face_normals, opaque,
+                          min_distance=self.plan.min_distance_normalized)
         kept = [kept_of[face, tuple(point)] for _d, face, point in hits]
         occlusion = occlusion_weight(np.array([d for d, _f, _p in hits]), d_max, settings.falloff)
         return expected_visibility(kept, list(occlusion))

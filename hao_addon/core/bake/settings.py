@@ -6,6 +6,7 @@ Blender properties, the command-line options and the README table are made from 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 from ..kernels import FALLOFF_CHOICES
@@ -84,6 +85,13 @@ class BakeSettings:
     normals: str = setting(
         "mesh", label="Normals", choices=NORMALS_CHOICES,
         description="which normal the hemisphere is about; visibility is always tested from the true surface")
+    spread_angle: float = setting(
+        90.0, label="Spread Angle", minimum=0.0, above_minimum=True, maximum=90.0, unit="degrees",
+        description="the cone about the normal that counts: directions farther from the normal weigh nothing "
+                    "(90 = the whole hemisphere; smaller gives a tighter, contact-like AO)")
+    min_distance: float = setting(
+        0.0, label="Min Distance", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
+        description="occluders nearer than this along a ray are ignored (the ray goes on past them); 0 = none")
     ignore_back_faces: bool = setting(
         False, label="Ignore Back Faces", description="faces seen from behind do not occlude (open or single-sided meshes)")
     margin: int = setting(
@@ -164,7 +172,13 @@ class BakeSettings:
     def abilities_needed(self, high_to_low: bool, tiled: bool = False) -> frozenset[str]:
         """What a baker must be able to bake for these settings (core/bake/abilities.py)."""
         kind = TARGET_KINDS[kind_name(self.target, high_to_low)]
-        return abilities_needed(self.max_distance, self.bent_normals, kind, tiled)
+        return abilities_needed(self.max_distance, self.bent_normals, kind, tiled, self.min_distance,
+                                self.spread_cos > 0.0)
+
+    @property
+    def spread_cos(self) -> float:
+        """cos(Spread Angle): the weight's cut-off (0 for the whole hemisphere)."""
+        return 0.0 if self.spread_angle >= 90.0 else math.cos(math.radians(self.spread_angle))
 
     @property
     def sample_count(self) -> int:
