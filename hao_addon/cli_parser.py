@@ -106,6 +106,11 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
                    help="also bake thickness (the occlusion of the inverted hemisphere by the mesh itself within "
                         "--thickness-distance; 1 thin, 0 nothing within reach) into this .png (16-bit) or .exr "
                         "(32-bit float) file; {object} as in --out")
+    b.add_argument("--orm-out", default="", metavar="FILE",
+                   help="also write glTF's occlusion-roughness-metallic texture: R the AO, G and B the material's "
+                        "roughness and metallic (values or image textures) in the baked UV layout, .png (16-bit, "
+                        "or --png-bits 8) or .exr; with --gltf-out the .glb's material uses it for occlusion, "
+                        "roughness and metallic; {object} as in --out")
     b.add_argument("--gltf-out", default="", metavar="FILE.glb",
                    help="also write the baked object as a .glb with the map as its material's occlusionTexture "
                         "(Blender's glTF exporter; the map on the UV map that was baked)")

@@ -207,6 +207,8 @@ CASES = [
                                     "spot"], 2, "--match-names finds the meshes by name: --high-poly does not apply"),
     ("thickness-colour-attribute", [BAKE, "{in}/spot.obj", "--target", "color-attribute", "--out", "{out}/m.ply",
                                     "--thickness-out", "{out}/t.png"], 2, "--thickness-out and --gltf-out are image"),
+    ("orm-colour-attribute", [BAKE, "{in}/spot.obj", "--target", "color-attribute", "--out", "{out}/m.ply",
+                              "--orm-out", "{out}/o.png"], 2, "--orm-out and --gltf-out are image bakes"),
     ("dither-16-bit", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--dither"], 2, "add --png-bits 8"),
     ("match-names-no-group", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names"], 2,
      "no mesh name (or collection) ends in '_low'"),

@@ -29,6 +29,7 @@ from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.job_options import JobOptions
+from ..core.bake.orm import orm_image
 from ..core.bake.tangent_space import bent_normal_map
 from ..core.bake.targets import BakeTarget
 from ..core.bake.texture_set import texture_set_target
@@ -36,6 +37,7 @@ from ..core.bake.udim import tile_path, udim_layout
 from ..core.geometry import TriangleSoup, face_normals_areas
 from ..core.bake.unwrap import unwrap_steps
 from . import color_attributes, images, mesh_data
+from .material_channels import roughness_metallic
 from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
 from .view_scene import BAKED_AO_PROPERTY
 
@@ -101,6 +103,9 @@ class BakeRequest:
     cage: "bpy.types.Object | None" = None
     bent_filepath: str = ""
     thickness_filepath: str = ""  # settings.thickness: the thickness map's file (tokens as filepath)
+    # glTF's occlusion-roughness-metallic texture (core/bake/orm.py) to this file (tokens as
+    # filepath); with wire_material it replaces the AO in the material's glTF wiring.
+    orm_filepath: str = ""
     options: JobOptions = field(default_factory=JobOptions)
     frames: list | None = None
     # What else the caller reads and writes, as (path, what) pairs, so that one check
@@ -191,6 +196,9 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
     if request.bent_filepath and not request.settings.bent_normals:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
+    if request.orm_filepath and (request.to_color_attribute or request.options.texture_set):
+        raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
+                             "texture set)")
     if request.thickness_filepath and not request.settings.thickness:
         raise BakeInputError("a thickness file needs the Thickness setting on")
     if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
@@ -215,7 +223,8 @@ def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
 def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
     """The image files a request writes per target: (kind, path pattern, what, channels)."""
     return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4),
-            ("thickness", request.thickness_filepath, "the thickness map", 1))
+            ("thickness", request.thickness_filepath, "the thickness map", 1),
+            ("orm", request.orm_filepath, "the ORM texture", 4))
 
 
 def _file_owners(request: BakeRequest) -> list:
@@ -364,6 +373,7 @@ class BakeJob:
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.thickness_maps: dict[str, np.ndarray] = {}  # object name -> (size, size) thickness
+        self.orm_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) ORM texture
         self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
         # A frame sequence: per frame {frame, seconds, reused, outputs} (its maps are written
@@ -482,6 +492,7 @@ class BakeJob:
                                                outputs=outputs))
                 self.bent_images.clear()
                 self.thickness_maps.clear()
+                self.orm_images.clear()
         finally:  # also when cancelled: the scene goes back to its frame
             scene.frame_set(original)
         self.finished = True
@@ -537,6 +548,8 @@ class BakeJob:
                 thick = yield from _with_status(steps, start + share * (k + 1) / len(units),
                                                 f"Baking thickness of '{label}'{at}")
                 self.thickness_maps[label] = thick.ao
+            if req.orm_filepath:
+                self.orm_images[label] = self._orm_image(obj, depsgraph, soup, result)
             if settings.bent_normals:
                 self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
                                                            soup, result)
@@ -544,6 +557,16 @@ class BakeJob:
             self.results.extend((o, uv_names[o.name], result) for o in objects)
             if key is not None:
                 self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
+
+    def _orm_image(self, obj, depsgraph, target: TriangleSoup, result: BakeResult) -> np.ndarray:
+        """(size, size, 4) ORM texture of a finished bake: its AO, the object's roughness and
+        metallic in the baked UV layout (blender/material_channels.py)."""
+        if result.tiles:
+            raise BakeInputError("the ORM texture is a glTF texture, and glTF has no UDIM tiles: these UVs lie on "
+                                 "several; bake without --orm-out")
+        settings = self.request.settings
+        roughness, metallic = roughness_metallic(obj, depsgraph, target.uvs, settings.size, settings.margin)
+        return orm_image(result.ao, roughness, metallic)
 
     def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target: TriangleSoup,
                     result: BakeResult):
@@ -647,7 +670,7 @@ class BakeJob:
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
                         maps = {"ao": result.ao, "bent": self.bent_images.get(label),
-                                "thickness": self.thickness_maps.get(label)}[kind]
+                                "thickness": self.thickness_maps.get(label), "orm": self.orm_images.get(label)}[kind]
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
@@ -673,7 +696,7 @@ class BakeJob:
         material nodes of self.results."""
         req = self.request
         files = self.files
-        stored = {}
+        stored, extra = {}, {}
         for obj, label, result in self.baked():
             name = req.image_name or f"{label}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
@@ -681,16 +704,19 @@ class BakeJob:
             stored[label] = self._store_image(result.ao, result.tiles, name, existing, files.get((label, "ao")))
             self.committed.append(stored[label])
             for kind, maps, suffix in (("bent", self.bent_images, "BentNormals"),
-                                       ("thickness", self.thickness_maps, "Thickness")):
+                                       ("thickness", self.thickness_maps, "Thickness"), ("orm", self.orm_images, "ORM")):
                 if label in maps:
                     name = f"{label}_{suffix}"
-                    self.committed.append(self._store_image(maps[label], result.tiles, name,
-                                                            bpy.data.images.get(name), files.get((label, kind))))
+                    extra[label, kind] = self._store_image(maps[label], result.tiles, name, bpy.data.images.get(name),
+                                                           files.get((label, kind)))
+                    self.committed.append(extra[label, kind])
         for obj, uv_name, _result in self.results:
             image = stored[self.label_of(obj)]
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
                 images.wire_into_material(obj, image, uv_name)
+                if (self.label_of(obj), "orm") in extra:  # glTF's ORM texture in place of the AO's
+                    images.wire_orm(obj, extra[self.label_of(obj), "orm"], uv_name)
 
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""
@@ -727,3 +753,4 @@ class BakeJob:
         self.results.clear()
         self.bent_images.clear()
         self.thickness_maps.clear()
+        self.orm_images.clear()

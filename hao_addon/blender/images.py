@@ -47,6 +47,37 @@ def wire_gltf_occlusion(tree: bpy.types.NodeTree, tex: bpy.types.Node) -> None:
         tree.links.new(tex.outputs["Color"], socket)
 
 
+ORM_NODE_LABEL = "HAO ORM"
+
+
+def wire_orm(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str) -> None:
+    """Wire an ORM texture (R occlusion, G roughness, B metallic; core/bake/orm.py) into the
+    object's active material, as glTF export packs it: through a Separate Color node, R to the
+    glTF Material Output's Occlusion, G to the Principled BSDF's Roughness, B to its Metallic
+    (the exporter then writes one image as occlusionTexture and metallicRoughnessTexture).
+    Call after wire_into_material (which made the material's AO nodes)."""
+    tree = obj.active_material.node_tree
+    tex = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeTexImage' and n.label == ORM_NODE_LABEL), None)
+    if tex is None:
+        tex = tree.nodes.new('ShaderNodeTexImage')
+        tex.label = ORM_NODE_LABEL
+        tex.location = (-700, -100)
+        uv_node = tree.nodes.new('ShaderNodeUVMap')
+        uv_node.location = (-900, -100)
+        uv_node.uv_map = uv_name
+        tree.links.new(uv_node.outputs["UV"], tex.inputs["Vector"])
+    tex.image = image
+    split = tree.nodes.new('ShaderNodeSeparateColor')
+    split.location = (-450, -100)
+    tree.links.new(tex.outputs["Color"], split.inputs[0])
+    group = next(n for n in tree.nodes if n.bl_idname == 'ShaderNodeGroup' and n.node_tree == gltf_output_group())
+    tree.links.new(split.outputs[0], group.inputs[GLTF_OCCLUSION])
+    bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
+    if bsdf is not None:
+        tree.links.new(split.outputs[1], bsdf.inputs["Roughness"])
+        tree.links.new(split.outputs[2], bsdf.inputs["Metallic"])
+
+
 def store_map_image(pixels: np.ndarray, name: str, existing: bpy.types.Image | None = None) -> bpy.types.Image:
     """Put a baked map (row 0 = bottom) into a float image datablock, colour space Non-Color
     (AO and normals are data, not colour): (H, W) accessibility as grey RGB with alpha 1, or
