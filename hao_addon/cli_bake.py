@@ -218,15 +218,7 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
 
     request, settings = job.request, run.settings
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
-    for obj, uv_name, result in job.results:
-        st = result.stats
-        report.objects.append(dict(name=obj.name, triangles=st["target_faces"],
-                                   uv_map=uv_name, uv_map_created=any(n == uv_name for _m, n in job.created_uv),
-                                   covered_texels=st["covered_texels"], method=st["method"],
-                                   smooth_corners=st["smooth_corners"],
-                                   **({"texture_set": True} if args.texture_set else {}),
-                                   **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
-                                   **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+    report.objects.extend(job.summary())
     lines = []
     for obj, label, result in job.baked():
         st = result.stats

@@ -22,6 +22,25 @@ from hao_addon import compat  # noqa: E402
 
 _EXIT_STATUS = 0
 
+# Tests of CPU code that is the same on every Blender release (the ray-traced reference, a
+# process's memory), each tens of seconds, are marked `release_independent`: they run on
+# every release but the oldest, which CI runs too (tools/test.sh), to keep CI within its time.
+OLDEST_RELEASE = (4, 2)
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "release_independent: CPU-only and release-independent; skipped on the "
+                                       "oldest release (run on the newest)")
+
+
+def pytest_collection_modifyitems(config, items):
+    if tuple(bpy.app.version[:2]) != OLDEST_RELEASE:
+        return
+    skip = pytest.mark.skip(reason="release-independent CPU test: run on the newest release (CI time)")
+    for item in items:
+        if "release_independent" in item.keywords:
+            item.add_marker(skip)
+
 
 def pytest_sessionfinish(session, exitstatus):
     global _EXIT_STATUS

@@ -172,6 +172,7 @@ def max_rss_mib(args: list, tmp: Path) -> float:
     return kib / 1024.0
 
 
+@pytest.mark.release_independent
 def test_memory_of_a_sequence_is_flat_in_the_frame_count(tmp_path):
     """Issue 28's target: within 50 MB between 4 and 40 frames at 1024^2 (it was +8 MB a
     frame: every frame's maps were held until the end)."""

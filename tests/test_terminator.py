@@ -97,6 +97,7 @@ def test_gpu_texel_list_lifts_like_numpy(gpu_context):
     np.testing.assert_allclose(lift[keep], expected, atol=2e-6)
 
 
+@pytest.mark.release_independent
 def test_reference_matches_cycles_default_only_with_the_offset(gpu_context):
     """Spot shaded smooth, Cycles' default offset (0.1): the ray-traced reference's bias
     against Cycles is +0.0001 with the lift and -0.0017 without it (256 directions; Cycles'

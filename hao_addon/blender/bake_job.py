@@ -718,6 +718,23 @@ class BakeJob:
                 if (self.label_of(obj), "orm") in extra:  # glTF's ORM texture in place of the AO's
                     images.wire_orm(obj, extra[self.label_of(obj), "orm"], uv_name)
 
+    def summary(self) -> list[dict]:
+        """One entry per baked object of the last bake (the --json report's objects): its
+        triangles, UV map (and whether the job made it), covered texels, the method, shaded
+        corners, and where they apply missed texels (Selected to Active), UDIM tiles, the
+        texture set it joined."""
+        out = []
+        for obj, uv_name, result in self.results:
+            st = result.stats
+            out.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
+                            uv_map_created=any(n == uv_name for _m, n in self.created_uv),
+                            covered_texels=st["covered_texels"], method=st["method"],
+                            smooth_corners=st["smooth_corners"],
+                            **({"texture_set": True} if self.request.options.texture_set else {}),
+                            **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
+                            **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+        return out
+
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""
         return TEXTURE_SET_NAME if self.request.options.texture_set else obj.name
