@@ -6,16 +6,7 @@
  * fragment's depth, so two surfaces on one pixel are kept independently. */
 float alpha_uniform(uvec3 v)
 {
-  /* pcg3d (Jarzynski & Olano 2020) */
-  v = v * 1664525u + 1013904223u;
-  v.x += v.y * v.z;
-  v.y += v.z * v.x;
-  v.z += v.x * v.y;
-  v ^= v >> 16u;
-  v.x += v.y * v.z;
-  v.y += v.z * v.x;
-  v.z += v.x * v.y;
-  return float(v.x >> 8u) * (1.0 / 16777216.0);
+  return float(pcg3d(v).x >> 8u) * (1.0 / 16777216.0);
 }
 
 bool alpha_keeps()

@@ -41,3 +41,15 @@ def assert_within_sample_tolerance(stats: dict, directions: int, label: str = ""
     assert abs(stats["bias"]) <= s / 8, f"{label} bias {stats['bias']:.4f} > {s / 8:.4f} ({stats})"
     bound = max(2 * s, max_floor)
     assert stats["max"] <= bound, f"{label} max error {stats['max']:.4f} > {bound:.4f} ({stats})"
+
+
+def load_image_rgba(path) -> np.ndarray:
+    """(H, W, 4) float32 pixels of an image file as Blender reads it, Non-Color (row 0 = bottom)."""
+    import bpy
+    image = bpy.data.images.load(str(path), check_existing=False)
+    image.colorspace_settings.name = 'Non-Color'
+    w, h = image.size
+    px = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(px)
+    bpy.data.images.remove(image)
+    return px.reshape(h, w, 4)

@@ -88,12 +88,8 @@ def _hao(*args, tmp: Path) -> subprocess.CompletedProcess:
 
 
 def _red(path: Path) -> np.ndarray:
-    image = bpy.data.images.load(str(path), check_existing=False)
-    image.colorspace_settings.name = 'Non-Color'
-    px = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-    image.pixels.foreach_get(px)
-    bpy.data.images.remove(image)
-    return px[0::4]
+    from bake_helpers import load_image_rgba
+    return load_image_rgba(path)[..., 0].ravel()
 
 
 ALL = {"crate_low", "crate_high", "crate_high.001", "rock_low", "rock_high", "rock_high.001", "pebble", "lamp",

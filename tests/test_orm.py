@@ -12,14 +12,7 @@ from test_gltf import assert_valid_gltf, read_glb
 STEP = 1.0 / 255.0
 
 
-def load_rgba(path) -> np.ndarray:
-    image = bpy.data.images.load(str(path), check_existing=False)
-    image.colorspace_settings.name = 'Non-Color'
-    w, h = image.size
-    px = np.empty(w * h * 4, np.float32)
-    image.pixels.foreach_get(px)
-    bpy.data.images.remove(image)
-    return px.reshape(h, w, 4)
+from bake_helpers import load_image_rgba as load_rgba  # noqa: E402
 
 
 def test_cli_orm_out_packs_ao_roughness_metallic_and_the_glb_uses_it(tmp_path):

@@ -110,14 +110,8 @@ def test_scatter_refuses_tiles_and_auto_gathers(gpu_context):
 
 def read_png(path) -> np.ndarray:
     """(H, W) red channel of an image file as stored (row 0 = bottom)."""
-    import bpy
-    image = bpy.data.images.load(str(path), check_existing=False)
-    image.colorspace_settings.name = 'Non-Color'
-    w, h = image.size
-    px = np.empty(w * h * 4, np.float32)
-    image.pixels.foreach_get(px)
-    bpy.data.images.remove(image)
-    return px.reshape(h, w, 4)[..., 0]
+    from bake_helpers import load_image_rgba
+    return load_image_rgba(path)[..., 0]
 
 
 def test_operator_bakes_a_tiled_image_and_one_file_per_tile(scene, tmp_path):

@@ -61,7 +61,7 @@ def _ao_info(march: str, falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     info.image(3, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
     info.image(4, 'R32UI', 'UINT_2D', "counters", qualifiers={'READ', 'WRITE'})
     add_defines(info, GLSL_DEFINES)
-    info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "hao_march.glsl", "hao_ao.comp"))
+    info.compute_source(glsl_source("pcg3d.glsl", "hao_common.glsl", "hao_pick.glsl", "hao_march.glsl", "hao_ao.comp"))
     return info
 
 
@@ -81,7 +81,7 @@ def _bilateral_info(axis: int, upsample: bool) -> "gpu.types.GPUShaderCreateInfo
     if upsample:
         info.image(4, 'RGBA32F', 'FLOAT_2D', "low_position", qualifiers={'READ'})
         info.image(5, 'RGBA32F', 'FLOAT_2D', "low_normal", qualifiers={'READ'})
-    info.compute_source(glsl_source("hao_common.glsl", "hao_bilateral.comp"))
+    info.compute_source(glsl_source("pcg3d.glsl", "hao_common.glsl", "hao_bilateral.comp"))
     return info
 
 

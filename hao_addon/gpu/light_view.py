@@ -127,7 +127,7 @@ def _alpha_info(fragment: str, layered: bool) -> "gpu.types.GPUShaderCreateInfo"
         info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
         info.define("LAYERS", str(LAYERS))
     info.vertex_source(glsl_source("bake_alpha.vert"))
-    info.fragment_source(glsl_source("bake_alpha.glsl", fragment))
+    info.fragment_source(glsl_source("pcg3d.glsl", "bake_alpha.glsl", fragment))
     return info
 
 

@@ -31,7 +31,7 @@ def _near_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     info.image(3, 'RGBA32F', 'FLOAT_2D', "back_normal", qualifiers={'READ'})
     info.image(4, 'R32F', 'FLOAT_2D', "ao_low", qualifiers={'WRITE'})
     add_defines(info, GLSL_DEFINES)
-    info.compute_source(glsl_source("hao_common.glsl", "hao_pick.glsl", "near_field.comp"))
+    info.compute_source(glsl_source("pcg3d.glsl", "hao_common.glsl", "hao_pick.glsl", "near_field.comp"))
     return info
 
 

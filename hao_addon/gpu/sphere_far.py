@@ -33,7 +33,7 @@ def _far_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     if falloff == "wendland":
         info.define("WENDLAND_FALLOFF", "1")
     info.vertex_source(glsl_source("sphere_far.vert"))
-    info.fragment_source(glsl_source("hao_common.glsl", "sphere_far.frag"))
+    info.fragment_source(glsl_source("pcg3d.glsl", "hao_common.glsl", "sphere_far.frag"))
     return info
 
 

@@ -42,7 +42,7 @@ GLSL_DEFINES = {"HAO_GOLDEN_FRACTION": GOLDEN_FRACTION, "HAO_SELF_OFFSET": SELF_
 
 
 def pcg3d(v: np.ndarray) -> np.ndarray:
-    """PCG3D hash (Jarzynski & Olano 2020) of (n, 3) uint32, as in hao_common.glsl."""
+    """PCG3D hash (Jarzynski & Olano 2020) of (n, 3) uint32, as in gpu_shaders/pcg3d.glsl."""
     v = np.array(v, dtype=np.uint32, copy=True)
     with np.errstate(over="ignore"):
         v = v * np.uint32(1664525) + np.uint32(1013904223)
