@@ -65,7 +65,31 @@ float visible_from(sampler2D depth_tex, int k, vec3 position, vec3 plane_normal,
   /* A cleared pixel (depth 1) holds no surface, even where the extrapolated plane passes the
    * far end of the view's depth range. */
   float stored = texelFetch(depth_tex, ivec2(lookup.xy), 0).r;
+#ifdef ALPHA_TAPS
+  /* Occluders that let light through are kept per pixel at random (core/bake/alpha.py): the
+   * mean of this pixel and its three neighbours towards the receiver's point, each tested at
+   * its own centre on the receiver's plane, draws four times for the noise of one. */
+  vec4 view_info = views.view_info[k];
+  vec3 light_pos = (views.view_proj[k] * vec4(position, 1.0)).xyz;
+  vec2 at = (light_pos.xy * 0.5 + 0.5) * view_info.xy;
+  vec3 m = mat3(views.view_proj[k]) * plane_normal;
+  float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
+  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
+  float depth = light_pos.z * 0.5 + 0.5;
+  float slack = DEPTH_BIAS_PIXELS * view_info.z + slope_slack * length(slope);
+  vec2 toward = sign(at - (lookup.xy + 0.5));
+  float seen = (lookup.z <= stored || stored >= 1.0) ? 1.0 : 0.0;
+  for (int t = 1; t < 4; t++) {
+    vec2 px = lookup.xy + vec2(float(t & 1), float(t >> 1)) * toward;
+    px = clamp(px, vec2(0.0), view_info.xy - 1.0);
+    float plane_depth = min(depth + dot(slope, px + 0.5 - at), depth) - slack;
+    float tap = texelFetch(depth_tex, ivec2(px), 0).r;
+    seen += (plane_depth <= tap || tap >= 1.0) ? 1.0 : 0.0;
+  }
+  return 0.25 * seen;
+#else
   return (lookup.z <= stored || stored >= 1.0) ? 1.0 : 0.0;
+#endif
 }
 #endif
 

@@ -78,6 +78,8 @@ def test_half_alpha_card_over_a_floor_lets_half_the_light_through(gpu_context, m
     stats = error_stats(res.ao, np.full(res.ao.shape, truth), res.covered)
     assert_within_alpha_tolerance(stats, DIRS, method)
     assert res.stats["alpha_faces"] > 0
+    if method == "gather" and max_distance == 0.0:  # four depth taps a test: half the noise of one
+        assert stats["rmse"] <= 0.6 * stochastic_sigma(DIRS), stats
     opaque = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="off"), use_cache=False)
     assert opaque.ao[opaque.covered].mean() < truth - 0.3  # 'off': today's solid sheet
     clipped = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="clip", alpha_clip=0.6),

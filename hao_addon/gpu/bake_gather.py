@@ -179,7 +179,8 @@ ACCUM_BINDINGS = (2, 6)
 
 
 def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool,
-                 estimator: Estimator, spread_cos: float = 0.0) -> "gpu.types.GPUShaderCreateInfo":
+                 estimator: Estimator, spread_cos: float = 0.0, alpha_taps: bool = False
+                 ) -> "gpu.types.GPUShaderCreateInfo":
     """falloff: None for unlimited distance (depth maps), else the max-distance falloff
     ('none', 'wendland'), tested against per-pixel depth lists; terminator: entries carry
     their terminator lift (image entry_lift); estimator: what each direction adds."""
@@ -205,6 +206,8 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         info.define("UNIFORM_WEIGHTING", "1")
     if spread_cos > 0.0:
         info.define("SPREAD_COS", repr(float(spread_cos)))
+    if alpha_taps:
+        info.define("ALPHA_TAPS", "1")
     info.push_constant('INT', "first_entry")
     info.push_constant('INT', "entry_end")
     info.typedef_source(glsl_source("bake_gather_views.glsl"))
@@ -233,12 +236,15 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
 
 def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
                   terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION,
-                  spread_cos: float = 0.0) -> "gpu.types.GPUShader":
+                  spread_cos: float = 0.0, alpha_taps: bool = False) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to GATHER_MAX_VIEWS) directions per dispatch; shading:
     entries carry shading normals (plan.smooth_shading); falloff, terminator, estimator: see
-    _gather_info; spread_cos: the spread cone's cut-off (0: the hemisphere)."""
-    return cached_shader(("bake_gather", uniform, views, shading, falloff, terminator, estimator.define, spread_cos),
-                         lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator, spread_cos))
+    _gather_info; spread_cos: the spread cone's cut-off (0: the hemisphere); alpha_taps: each
+    depth test the mean of four pixels (plan.alpha 'blend': four draws of its stochastic
+    keeping for the noise of one)."""
+    key = ("bake_gather", uniform, views, shading, falloff, terminator, estimator.define, spread_cos, alpha_taps)
+    return cached_shader(key, lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator, spread_cos,
+                                                   alpha_taps))
 
 
 class GatherBaker(LightViewBaker):
@@ -518,7 +524,7 @@ class GatherBaker(LightViewBaker):
         # One variant per bake: a last, short batch fills the other slots with padding (omega 0).
         shader = gather_shader(settings.weighting == "uniform", self.slots, self.shading_layout,
                                self.plan.layered_falloff if self.layered else None, self.lifted, self.plan.estimator,
-                               settings.spread_cos)
+                               settings.spread_cos, self.plan.alpha is not None and self.plan.alpha.mode == "blend")
         shader.bind()
         shader.uniform_block("views", self.views_block)
         if self.layered:
