@@ -193,3 +193,40 @@ def test_a_group_without_high_poly_bakes_its_own_parts(scene):
     pair = baked([wall, ball], occluders="selected")
     np.testing.assert_array_equal(grouped["wall_low"], pair["wall_low"])
     assert grouped["wall_low"].min() < 0.5  # the ball darkens the wall under it
+
+
+def test_groups_bake_into_one_texture_set_when_asked(scene, tmp_path):
+    """Two groups whose low-polys' islands sit side by side (u < 0.5, u > 0.5): one shared
+    image, each half its own group's bake, texel for texel."""
+    from hao_addon.blender.bake_job import BakeJob
+    from hao_addon.core.geometry import TriangleSoup
+
+    def low(name: str, x: float, half: int) -> object:
+        soup = scenes.grid_plane(2.0, 4, z=1.2, name=name)
+        uvs = soup.uvs * [0.5, 1.0] + [0.5 * half, 0.0]
+        return soup_to_object(TriangleSoup(soup.positions + [x, 0, 0], uvs, name), name)
+
+    low("a_low", 0.0, 0)
+    low("b_low", 10.0, 1)
+    soup_to_object(scenes.uv_sphere(0.5, (0, 0, 0.5), 24, 12, name="a_high"), "a_high")
+    soup_to_object(scenes.grid_plane(4.0, 4, name="a_high.001"), "a_high.001")
+    soup_to_object(scenes.uv_sphere(0.4, (10.3, 0, 0.4), 24, 12, name="b_high"), "b_high")
+    soup_to_object(TriangleSoup(scenes.grid_plane(4.0, 4).positions + [10, 0, 0], None, "b_high.001"), "b_high.001")
+    meshes = [o for o in scene.objects if o.type == 'MESH']
+    select_only(*meshes)
+
+    def run(**kw):
+        settings = small_settings(scene, match_names=True, size=64, directions=32, margin=2, **kw)
+        job = BakeJob(settings.to_request(meshes), bpy.context.evaluated_depsgraph_get)
+        job.run()
+        return job
+
+    shared = run(texture_set=True)
+    assert len(shared.baked()) == 1 and shared.baked()[0][1] == "TextureSet"
+    merged = shared.baked()[0][2]
+    singles = {obj.name: result for obj, _uv, result in run().results}
+    for name, half in (("a_low", slice(0, 32)), ("b_low", slice(32, 64))):
+        own = singles[name]
+        mask = own.covered[:, half]
+        np.testing.assert_array_equal(merged.ao[:, half][mask], own.ao[:, half][mask])
+    assert sorted(e["name"] for e in shared.summary()) == ["a_low", "b_low"]

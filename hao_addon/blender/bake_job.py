@@ -321,9 +321,12 @@ def _validate_color_attribute(request: BakeRequest) -> None:
 def _validate_groups(request: BakeRequest) -> None:
     if request.high_poly is not None or request.cage is not None:
         raise BakeInputError("bake groups find their high-poly meshes by name: no separate high-poly or cage")
-    if request.options.texture_set or request.to_color_attribute:
-        raise BakeInputError("bake groups bake each low-poly into its own image (not a texture set or a colour "
-                             "attribute)")
+    if request.to_color_attribute:
+        raise BakeInputError("bake groups bake each low-poly into an image (not a colour attribute)")
+    if request.options.texture_set and (request.settings.bent_normals or request.settings.thickness
+                                        or request.orm_filepath or request.frames):
+        raise BakeInputError("bake groups in one texture set bake the AO of one frame (not bent normals, thickness, "
+                             "an ORM texture or frames)")
     if not request.groups:
         raise BakeInputError(f"no bake group found: no mesh name ends in '{request.options.low_suffix}'")
     for group in request.groups:
@@ -373,6 +376,7 @@ class BakeJob:
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.thickness_maps: dict[str, np.ndarray] = {}  # object name -> (size, size) thickness
+        self.own_stats: dict[str, dict] = {}  # bake groups in a texture set: each low-poly's own bake's stats
         self.orm_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) ORM texture
         self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
@@ -452,7 +456,7 @@ class BakeJob:
             stand_ins = {o for g in self.request.groups if g.highs for o in g.lows}
             occluders = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()
                          and o not in stand_ins and o != low and o not in (sources or ())]
-        return BakeUnit(low.name, [low], sources, occluders)
+        return BakeUnit(TEXTURE_SET_NAME if self.request.options.texture_set else low.name, [low], sources, occluders)
 
     def _high_to_low(self, low, depsgraph, high_poly: list) -> HighToLow:
         """The Selected-to-Active request of the low-poly: its sources (high_poly) with their
@@ -504,6 +508,10 @@ class BakeJob:
         req = self.request
         depsgraph = self._depsgraph_getter()
         units = self.units()
+        if req.groups is not None and req.options.texture_set:  # islands of different lows must not overlap
+            texture_set_target([mesh_data.evaluated_soup(u.objects[0], depsgraph, uv_names[u.objects[0].name] or None,
+                                                         shading_normals=False) for u in units],
+                               req.settings.size, TEXTURE_SET_NAME)
         at = "" if frame is None else f" at frame {frame}"
         for k, unit in enumerate(units):
             objects, label = unit.objects, unit.label
@@ -557,6 +565,26 @@ class BakeJob:
             self.results.extend((o, uv_names[o.name], result) for o in objects)
             if key is not None:
                 self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
+        if req.groups is not None and req.options.texture_set:
+            self._merge_group_set()
+
+    def _merge_group_set(self) -> None:
+        """Bake groups in one texture set: each low-poly was baked from its own group (a result
+        each); their islands, which do not overlap, make one map, each texel from the result
+        that fills it (the first where margins meet)."""
+        results = [result for _o, _uv, result in self.results]
+        first = results[0]
+        ao, covered, filled = first.ao.copy(), first.covered.copy(), first.filled.copy()
+        for result in results[1:]:
+            new = result.filled & ~filled
+            ao[new] = result.ao[new]
+            covered |= result.covered
+            filled |= result.filled
+        stats = {**first.stats, "covered_texels": int(covered.sum()),
+                 "warnings": [w for r in results for w in r.stats.get("warnings", [])]}
+        merged = BakeResult(ao, covered, filled, stats, None, first.tiles)
+        self.own_stats = {obj.name: result.stats for obj, _uv, result in self.results}
+        self.results = [(obj, uv, merged) for obj, uv, _r in self.results]
 
     def _orm_image(self, obj, depsgraph, target: TriangleSoup, result: BakeResult) -> np.ndarray:
         """(size, size, 4) ORM texture of a finished bake: its AO, the object's roughness and
@@ -725,7 +753,7 @@ class BakeJob:
         texture set it joined."""
         out = []
         for obj, uv_name, result in self.results:
-            st = result.stats
+            st = self.own_stats.get(obj.name, result.stats)
             out.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
                             uv_map_created=any(n == uv_name for _m, n in self.created_uv),
                             covered_texels=st["covered_texels"], method=st["method"],
