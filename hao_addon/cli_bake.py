@@ -82,6 +82,7 @@ def _checked_run(args, report: Report) -> _Run:
     from .core.bake.settings import BakeSettings
     from .core.imageio import check_writable
 
+    _fill_map_outputs(args)
     settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
     options = validated(settings_from_args(args, JobOptions), JobOptions)
     source = check_input(Path(args.input), INPUT_FORMATS)
@@ -116,6 +117,22 @@ def _checked_run(args, report: Report) -> _Run:
     check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
     key = run_key(args, [Path(path) for path, _what in reads])
     return _Run(settings, options, source, frames, gltf_out, mesh_out, reads, writes, key)
+
+
+def _fill_map_outputs(args) -> None:
+    """--maps: each map without its own output option is written beside --out, named after
+    it with _MAP before the extension."""
+    from .cli_parser import MAP_OUTPUTS
+
+    names = [name.strip() for name in (getattr(args, "maps", "") or "").split(",") if name.strip()]
+    unknown = [name for name in names if name not in MAP_OUTPUTS]
+    if unknown:
+        raise CLIError(f"--maps: unknown map '{unknown[0]}', expected some of {', '.join(MAP_OUTPUTS)}")
+    for name in names:
+        option = MAP_OUTPUTS[name]
+        if option and not getattr(args, option) and args.out:
+            stem, suffix = os.path.splitext(args.out)
+            setattr(args, option, f"{stem}_{name.replace('-', '_')}{suffix}")
 
 
 def _pick_objects(args, report: Report) -> tuple[list, list | None, object]:

@@ -61,6 +61,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# --maps: each map's own output option (argparse dest), its file named after --out with _MAP.
+MAP_OUTPUTS = {"ao": "", "bent-normal": "bent_normal_out", "thickness": "thickness_out", "orm": "orm_out"}
+
+
 def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     """What a bake takes (bake, and the farm commands that write bake jobs): inputs, outputs,
     frames and every bake setting."""
@@ -102,6 +106,11 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--bent-normal-out", default="", metavar="FILE",
                    help="also bake bent normals (the cosine-weighted mean unoccluded direction, same pass) into "
                         "this .png (16-bit) or .exr (32-bit float) RGB file, 0.5 + 0.5 n; {object} as in --out")
+    b.add_argument("--maps", default="", metavar="MAP[,MAP...]",
+                   help="the maps to bake, comma-separated, from " + ", ".join(MAP_OUTPUTS) + " (the AO always): "
+                        "each map without its own --...-out option is written beside --out, its name followed by "
+                        "_MAP (ao.png -> ao_thickness.png); bent normals and the ORM texture come from the AO's "
+                        "own pass, thickness from a second one")
     b.add_argument("--thickness-out", default="", metavar="FILE",
                    help="also bake thickness (the occlusion of the inverted hemisphere by the mesh itself within "
                         "--thickness-distance; 1 thin, 0 nothing within reach) into this .png (16-bit) or .exr "

@@ -18,7 +18,7 @@ from . import __version__
 # local run of the same bake (other paths, a chunk of the frames) share the key, so their
 # files are byte for byte the same.
 NOT_IN_KEY = frozenset({"command", "input", "out", "out_dir", "json", "quiet", "skip_existing", "frames",
-                        "bent_normal_out", "thickness_out", "orm_out", "gltf_out", "high_poly", "batch_inputs", "batch_outputs", "progress",
+                        "bent_normal_out", "thickness_out", "orm_out", "maps", "gltf_out", "high_poly", "batch_inputs", "batch_outputs", "progress",
                         "manifest", "chunk", "input_root"})
 
 

@@ -209,6 +209,8 @@ CASES = [
                                     "--thickness-out", "{out}/t.png"], 2, "--thickness-out and --gltf-out are image"),
     ("orm-colour-attribute", [BAKE, "{in}/spot.obj", "--target", "color-attribute", "--out", "{out}/m.ply",
                               "--orm-out", "{out}/o.png"], 2, "--orm-out and --gltf-out are image bakes"),
+    ("maps-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "ao,curvature"], 2,
+     "--maps: unknown map 'curvature'"),
     ("dither-16-bit", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--dither"], 2, "add --png-bits 8"),
     ("match-names-no-group", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names"], 2,
      "no mesh name (or collection) ends in '_low'"),
