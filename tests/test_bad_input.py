@@ -206,7 +206,7 @@ CASES = [
     ("match-names-with-high-poly", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names", "--high-poly",
                                     "spot"], 2, "--match-names finds the meshes by name: --high-poly does not apply"),
     ("thickness-colour-attribute", [BAKE, "{in}/spot.obj", "--target", "color-attribute", "--out", "{out}/m.ply",
-                                    "--thickness-out", "{out}/t.png"], 2, "--thickness-out and --gltf-out are image"),
+                                    "--thickness-out", "{out}/t.png"], 2, "--thickness-out, --orm-out and --gltf-out are image"),
     ("orm-colour-attribute", [BAKE, "{in}/spot.obj", "--target", "color-attribute", "--out", "{out}/m.ply",
                               "--orm-out", "{out}/o.png"], 2, "--orm-out and --gltf-out are image bakes"),
     ("maps-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "ao,curvature"], 2,
