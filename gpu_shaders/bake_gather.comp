@@ -18,40 +18,51 @@
  * grazing angles, which strongly bent shading normals weigh in: +0.004 brighter than Cycles
  * and the ray-traced reference on Spot with custom normals. Returns (pixel, depth), pixel.x
  * < 0 outside the view. */
-vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
+/* The receiver in view k: `at` its pixel coordinates, `depth` its depth (z / 2 + 1 / 2), and
+ * `slope` how its plane's depth changes per pixel: plane_slope.xy * m.xy / m.z, m the plane
+ * normal through the view's linear part (core/bake/views.OrthoView.plane_slope: for an
+ * orthographic view, S R with R a rotation, the clip-space normal is S^-2 m; the view_proj
+ * entries are loaded for the position already, so this costs no further loads). */
+void receiver_plane(int k, vec3 position, vec3 plane_normal, out vec2 at, out float depth, out vec2 slope)
 {
-  vec4 view_info = views.view_info[k];
   vec3 light_pos = (views.view_proj[k] * vec4(position, 1.0)).xyz;
-  vec2 at = (light_pos.xy * 0.5 + 0.5) * view_info.xy; /* pixel coordinates */
-  vec2 px = floor(at);
-  if (any(lessThan(px, vec2(0.0))) || any(greaterThanEqual(px, view_info.xy))) {
-    return vec3(-1.0);
-  }
-  /* The plane's depth (z / 2 + 1 / 2) changes by plane_slope.xy * m.xy / m.z per pixel, m the
-   * plane normal through the view's linear part (core/bake/views.OrthoView.plane_slope: for
-   * an orthographic view, S R with R a rotation, the clip-space normal is S^-2 m; the
-   * view_proj entries are loaded for light_pos already, so this costs no further loads). */
+  at = (light_pos.xy * 0.5 + 0.5) * views.view_info[k].xy;
   vec3 m = mat3(views.view_proj[k]) * plane_normal;
   float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
-  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
-  float depth = light_pos.z * 0.5 + 0.5;
+  slope = views.plane_slope[k].xy * m.xy / mz;
+  depth = light_pos.z * 0.5 + 0.5;
+}
+
+/* What a depth stored at pixel px must lie nearer the light than to occlude the receiver:
+ * its plane there, or its own depth where that is nearer (where the plane runs away from the
+ * light towards the pixel centre, a surface between the two depths, such as a wall at the
+ * receiver's foot seen at a grazing angle, is beside the ray, not on it), less the bias. */
+float occluding_depth(int k, vec2 px, vec2 at, float depth, vec2 slope, float slope_slack)
+{
   float plane_depth = depth + dot(slope, px + 0.5 - at);
-  /* Only what lies nearer the light than the receiver can occlude it: where its plane runs
-   * away from the light towards the pixel centre, a surface there between the two depths
-   * (a wall at the receiver's foot, seen at a grazing angle) is beside the ray, not on it. */
-  float slack = DEPTH_BIAS_PIXELS * view_info.z + slope_slack * length(slope);
-  return vec3(px, min(plane_depth, depth) - slack);
+  float slack = DEPTH_BIAS_PIXELS * views.view_info[k].z + slope_slack * length(slope);
+  return min(plane_depth, depth) - slack;
+}
+
+vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
+{
+  vec2 at, slope;
+  float depth;
+  receiver_plane(k, position, plane_normal, at, depth, slope);
+  vec2 px = floor(at);
+  if (any(lessThan(px, vec2(0.0))) || any(greaterThanEqual(px, views.view_info[k].xy))) {
+    return vec3(-1.0);
+  }
+  return vec3(px, occluding_depth(k, px, at, depth, slope, slope_slack));
 }
 
 /* The depth of the receiver's plane at the centre of the pixel `position` falls in. */
 float receiver_plane_depth(int k, vec3 position, vec3 plane_normal)
 {
-  vec3 light_pos = (views.view_proj[k] * vec4(position, 1.0)).xyz;
-  vec2 at = (light_pos.xy * 0.5 + 0.5) * views.view_info[k].xy;
-  vec3 m = mat3(views.view_proj[k]) * plane_normal;
-  float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
-  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
-  return light_pos.z * 0.5 + 0.5 + dot(slope, floor(at) + 0.5 - at);
+  vec2 at, slope;
+  float depth;
+  receiver_plane(k, position, plane_normal, at, depth, slope);
+  return depth + dot(slope, floor(at) + 0.5 - at);
 }
 
 #ifndef MAX_DISTANCE
@@ -69,22 +80,15 @@ float visible_from(sampler2D depth_tex, int k, vec3 position, vec3 plane_normal,
   /* Occluders that let light through are kept per pixel at random (core/bake/alpha.py): the
    * mean of this pixel and its three neighbours towards the receiver's point, each tested at
    * its own centre on the receiver's plane, draws four times for the noise of one. */
-  vec4 view_info = views.view_info[k];
-  vec3 light_pos = (views.view_proj[k] * vec4(position, 1.0)).xyz;
-  vec2 at = (light_pos.xy * 0.5 + 0.5) * view_info.xy;
-  vec3 m = mat3(views.view_proj[k]) * plane_normal;
-  float mz = (m.z < 0.0) ? min(m.z, -1e-12) : max(m.z, 1e-12);
-  vec2 slope = views.plane_slope[k].xy * m.xy / mz;
-  float depth = light_pos.z * 0.5 + 0.5;
-  float slack = DEPTH_BIAS_PIXELS * view_info.z + slope_slack * length(slope);
+  vec2 at, slope;
+  float depth;
+  receiver_plane(k, position, plane_normal, at, depth, slope);
   vec2 toward = sign(at - (lookup.xy + 0.5));
   float seen = (lookup.z <= stored || stored >= 1.0) ? 1.0 : 0.0;
   for (int t = 1; t < 4; t++) {
-    vec2 px = lookup.xy + vec2(float(t & 1), float(t >> 1)) * toward;
-    px = clamp(px, vec2(0.0), view_info.xy - 1.0);
-    float plane_depth = min(depth + dot(slope, px + 0.5 - at), depth) - slack;
+    vec2 px = clamp(lookup.xy + vec2(float(t & 1), float(t >> 1)) * toward, vec2(0.0), views.view_info[k].xy - 1.0);
     float tap = texelFetch(depth_tex, ivec2(px), 0).r;
-    seen += (plane_depth <= tap || tap >= 1.0) ? 1.0 : 0.0;
+    seen += (occluding_depth(k, px, at, depth, slope, slope_slack) <= tap || tap >= 1.0) ? 1.0 : 0.0;
   }
   return 0.25 * seen;
 #else

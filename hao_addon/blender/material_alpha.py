@@ -12,7 +12,7 @@ from .. import compat
 from ..core.bake.alpha import SoupAlpha
 
 
-def _principled(material) -> "bpy.types.Node | None":
+def principled_bsdf(material) -> "bpy.types.Node | None":
     """The Principled BSDF the material's active output shows, or None."""
     tree = compat.material_node_tree(material)
     if tree is None:
@@ -45,7 +45,7 @@ def _alpha_image_node(socket) -> "bpy.types.Node | None":
 def material_alpha(material) -> tuple[float, "bpy.types.Node | None"]:
     """(constant alpha, the Image Texture node of its alpha or None) of a material; (1, None)
     for one that is opaque or whose alpha comes from nodes read here as opaque."""
-    bsdf = _principled(material)
+    bsdf = principled_bsdf(material)
     if bsdf is None:
         return 1.0, None
     alpha = bsdf.inputs['Alpha']
@@ -62,7 +62,7 @@ def image_alpha(image: "bpy.types.Image") -> np.ndarray:
     return pixels.reshape(h, w, 4)[..., 3].copy()
 
 
-def _uv_name(node, mesh: bpy.types.Mesh) -> str | None:
+def texture_uv_map(node, mesh: bpy.types.Mesh) -> str | None:
     """The UV map an Image Texture node reads: its UV Map node's, else the active render one."""
     vector = node.inputs['Vector']
     if vector.is_linked and vector.links[0].from_node.type == 'UVMAP' and vector.links[0].from_node.uv_map:
@@ -88,7 +88,7 @@ def soup_alpha(obj: bpy.types.Object, mesh: bpy.types.Mesh, tri_loops: np.ndarra
     constant = np.array([c for c, _node in found], np.float32)[face_slot]
     images, index, uvs = [], np.full(len(face_slot), -1, np.int64), None
     for k, (_c, node) in enumerate(found):
-        uv_name = None if node is None else _uv_name(node, mesh)
+        uv_name = None if node is None else texture_uv_map(node, mesh)
         if uv_name is None:
             continue
         faces = face_slot == k

@@ -10,14 +10,14 @@ import numpy as np
 
 from ..core.bake.orm import channel_map, sample_nearest
 from ..core.errors import BakeInputError
-from .material_alpha import _principled, _uv_name
+from .material_alpha import principled_bsdf, texture_uv_map
 
 CHANNELS = {"Red": 0, "Green": 1, "Blue": 2, "R": 0, "G": 1, "B": 2}
 
 
 def _source(material, name: str) -> tuple[float, object, int]:
     """(value, Image Texture node or None, its channel) of a Principled input."""
-    bsdf = _principled(material)
+    bsdf = principled_bsdf(material)
     if bsdf is None:
         return (0.5 if name == "Roughness" else 0.0), None, 0
     socket = bsdf.inputs[name]
@@ -62,7 +62,7 @@ def roughness_metallic(obj, depsgraph, uvs: np.ndarray, size: int, margin: int) 
         out = []
         for name in ("Roughness", "Metallic"):
             sources = [_source(m, name) for m in materials]
-            images = {k: (_pixels(node.image), loop_uvs(mesh, _uv_name(node, mesh))[tri_loops], channel)
+            images = {k: (_pixels(node.image), loop_uvs(mesh, texture_uv_map(node, mesh))[tri_loops], channel)
                       for k, (_v, node, channel) in enumerate(sources) if node is not None}
 
             def face_value(face, bary, sources=sources, images=images):
