@@ -41,7 +41,7 @@ def test_hemisphere_cosine_sum_approaches_quarter(count):
 def test_face_normalizer_matches_brute_force_and_zero_normal():
     d = directions.bake_directions(100, seed=1)
     n = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 0, 0]])
-    s = normalization.face_normalizers(n, d, "cosine", chunk=2)
+    s = normalization.face_normalizers(n, d, "cosine", block=200)  # two faces a block
     brute = [sum(max(float(x @ nn), 0.0) for x in d) for nn in n]
     # float32 products and sums: within D rounding steps of 2^-24 (relative) of float64.
     np.testing.assert_allclose(s, brute, rtol=len(d) * 2.0**-24)

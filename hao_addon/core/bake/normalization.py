@@ -32,12 +32,25 @@ def hemisphere_weight(cos_theta: np.ndarray, weighting: str, spread_cos: float =
     return weight if spread_cos <= 0.0 else np.where(cos_theta >= spread_cos, weight, 0.0).astype(weight.dtype)
 
 
+# Products computed at once, at most: a block's numpy calls stay short (a signal is acted on
+# between them, not after a second-long product: 14k faces x 16384 directions in one block
+# held Ctrl-C for 0.8 s and 0.9 GB) and the block stays in cache. At 256 directions the
+# blocks are 8192 faces (4096 corners), as before.
+FACE_BLOCK = 1 << 21
+CORNER_BLOCK = 1 << 20
+
+
+def _rows(block: int, directions: np.ndarray) -> int:
+    return max(1, block // max(1, len(directions)))
+
+
 def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str = "cosine",
-                     chunk: int = 8192, spread_cos: float = 0.0) -> np.ndarray:
+                     block: int = FACE_BLOCK, spread_cos: float = 0.0) -> np.ndarray:
     """S_f for each face.
 
     normals: (F, 3) unit face normals (zero rows for degenerate faces);
-    directions: (D, 3) unit directions. Returns (F,) float64; 0 where no direction sees the face.
+    directions: (D, 3) unit directions; block: products per step (faces x directions).
+    Returns (F,) float64; 0 where no direction sees the face.
 
     float32 products and sums (relative error ~1e-6, four times faster than float64: 0.14 s
     -> 0.03 s for 69k faces x 256 directions). Exactness does not rest on S_f: an open texel
@@ -50,6 +63,7 @@ def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str
     dirs_t = np.ascontiguousarray(np.asarray(directions, dtype=np.float32).T)
     ones = np.ones(dirs_t.shape[1], np.float32)
     out = np.empty(len(normals), dtype=np.float64)
+    chunk = _rows(block, directions)
     for start in range(0, len(normals), chunk):
         block = normals[start:start + chunk] @ dirs_t  # (chunk, D)
         if spread_cos > 0.0:
@@ -63,7 +77,7 @@ def face_normalizers(normals: np.ndarray, directions: np.ndarray, weighting: str
 
 
 def corner_normalizers(shading: np.ndarray, face_normals: np.ndarray, directions: np.ndarray,
-                       weighting: str = "cosine", chunk: int = 4096, spread_cos: float = 0.0
+                       weighting: str = "cosine", block: int = CORNER_BLOCK, spread_cos: float = 0.0
                        ) -> tuple[np.ndarray, np.ndarray]:
     """S and its above-face part at every corner of shaded faces.
 
@@ -80,6 +94,7 @@ def corner_normalizers(shading: np.ndarray, face_normals: np.ndarray, directions
     faces = np.asarray(face_normals, np.float32)
     total = np.empty((len(faces), 3))
     above = np.empty((len(faces), 3))
+    chunk = _rows(block, directions)
     for start in range(0, len(faces), chunk):
         up = (faces[start:start + chunk] @ dirs_t) > 0.0  # (chunk, D)
         for k in range(3):
