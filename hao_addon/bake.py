@@ -22,6 +22,9 @@ from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
+from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
+    replicate_twin
+from .core.directions import replicate_sizes
 from .core.bake.seams import element_values, finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
 from .core.bake.abilities import check_method, choose_method
@@ -45,6 +48,15 @@ class BakeResult:
     stats: dict = field(default_factory=dict)
     bent_normals: np.ndarray | None = None
     tiles: tuple[int, ...] | None = None
+    # The bake's own statistical error (core/bake/error_estimate.py): each covered texel's (or
+    # element's) twin, a draw from its error's distribution (ao's shape, 0 elsewhere), and
+    # the map's estimate from them; None with a single direction.
+    twin: np.ndarray | None = None
+    error: ErrorEstimate | None = None
+
+    def error_map(self) -> np.ndarray | None:
+        """ao's shape float32: each texel's estimated error (its neighbourhood's RMS twin)."""
+        return None if self.twin is None else local_rms(self.twin, self.covered)
 
 
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
@@ -121,7 +133,10 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
         return BakeResult(cached.ao, cached.covered, cached.filled, stats, cached.bent_normals, cached.tiles)
     # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
     with single_threaded_blas() as blas_threads:
-        result = yield from _bake_uncached(target, occluders, settings)
+        if settings.error_target > 0.0:
+            result = yield from _bake_to_error(target, occluders, settings)
+        else:
+            result = yield from _bake_uncached(target, occluders, settings)
     result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
                         target_name=target.name)
     if key is not None:
@@ -158,16 +173,25 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     baker = baker_cls(plan)
     try:
         count = settings.directions
+        split = replicate_sizes(count)[0]  # the second replicate's first direction
+        sums_a = None
         for i in range(count):
+            if i == split:  # each replicate summed apart (core/bake/error_estimate.py)
+                sums_a = baker.accumulated()
+                baker.restart()
             baker.run_direction(i)
             yield share + (1.0 - share) * (i + 1) / count
         sums = baker.accumulated()
+        sums_b = None
+        if sums_a is not None:  # the map is the replicates' mean (each receiver weighs 1 in each)
+            sums, sums_b = sums_a + sums, sums
         gpu_stats = dict(baker.stats)
     finally:
         baker.free()
     # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py), or
     # the colour attribute's values, one per element.
     bent = None
+    twin = None if sums_a is None else replicate_twin(*plan.estimator.ratio(sums_a), *plan.estimator.ratio(sums_b))
     if plan.vertex_target is not None:
         ao, covered, filled = element_values(*plan.estimator.ratio(sums))
     else:  # one map, or one per UDIM tile, each with its own margins
@@ -180,10 +204,81 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         if plan.udim is None:
             ao, covered, filled = ao[0], covered[0], filled[0]
             bent = None if bent is None else bent[0]
+    if twin is not None:
+        twin = np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
+    error = None if twin is None else estimate(twin, covered, count)
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
-             "cache_hit": False}
+             "cache_hit": False, "error": None if error is None else error.as_dict()}
     tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
-    return BakeResult(ao, covered, filled, stats, bent, tile_numbers)
+    return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error)
+
+
+def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings
+                   ) -> Generator[float, None, BakeResult]:
+    """Rounds of whole bakes, each with its own direction set, until the estimated p99 of their
+    union is within settings.error_target or settings.directions are spent (capped). Each
+    round's size is predicted from the error so far (core/bake/error_estimate.next_round); the
+    rounds are averaged weighted by their directions, and so are their twins (independent
+    rounds: the union's twin is still a draw of the union's error)."""
+    target_error, cap = settings.error_target, settings.directions
+    results, history, skippable = [], [], 0.0
+    size, done, shown = min(cap, PILOT_DIRECTIONS), 0, 0.0
+    while size > 0:
+        round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
+                                 seed=(settings.seed + 7919 * len(results)) % 2**31)
+        steps = _bake_uncached(target, occluders, round_settings)
+        try:
+            while True:
+                try:
+                    fraction = next(steps)
+                except StopIteration as stop:
+                    part = stop.value
+                    break
+                shown = max(shown, min(0.99, (done + fraction * size) / max(done + size, 1)))
+                yield shown
+        finally:
+            steps.close()
+        if results and results[-1][1].twin is not None:  # what a texel-skipping method would not bake
+            skippable += size * float(converged(combined.twin, combined.covered, target_error).sum()) / max(
+                1, int(combined.covered.sum()))
+        results.append((size, part))
+        done += size
+        combined = _combine_rounds(results)
+        if combined.error is None:
+            break
+        history.append((done, combined.error.p99))
+        size = next_round(history, target_error, cap)
+    capped = combined.error is not None and combined.error.p99 > target_error
+    error = None if combined.error is None else replace(combined.error, capped=capped)
+    stats = {**combined.stats, "error": None if error is None else error.as_dict(), "error_target": target_error,
+             "rounds": [n for n, _r in results], "skippable_fraction": skippable / max(done, 1)}
+    if capped:
+        stats["warnings"] = [*stats.get("warnings", []),
+                             f"'{target.name}': the estimated p99 error {error.p99:.2g} is above the target "
+                             f"{target_error:.2g} after {done} directions (the cap, Directions); raise Directions"]
+    return replace(combined, stats=stats, error=error)
+
+
+def _combine_rounds(results: list[tuple[int, BakeResult]]) -> BakeResult:
+    """The rounds' union: maps, bent normals and twins averaged weighted by directions."""
+    total = sum(n for n, _r in results)
+    last = results[-1][1]
+    if len(results) == 1:
+        return last
+    covered = np.logical_and.reduce([r.covered for _n, r in results])
+    filled = np.logical_and.reduce([r.filled for _n, r in results])
+    ao = (sum(n * r.ao.astype(np.float64) for n, r in results) / total).astype(np.float32)
+    bent = None
+    if last.bent_normals is not None:
+        mean = sum(n * r.bent_normals.astype(np.float64) for n, r in results)
+        length = np.linalg.norm(mean, axis=-1, keepdims=True)
+        bent = np.divide(mean, length, out=np.zeros_like(mean), where=length > 0).astype(np.float32)
+    twin = None
+    if all(r.twin is not None for _n, r in results):
+        twin = np.where(covered, sum(n * r.twin.astype(np.float64) for n, r in results) / total, 0.0).astype(np.float32)
+    error = None if twin is None else estimate(twin, covered, total)
+    stats = {**last.stats, "directions": total, "error": None if error is None else error.as_dict()}
+    return BakeResult(ao, covered, filled, stats, bent, last.tiles, twin, error)
 
 
 def inverted(soup: TriangleSoup) -> TriangleSoup:
@@ -212,7 +307,8 @@ def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: boo
     inside = replace(inside, method=method)
     result = yield from bake_steps(inverted(target), [], inside, use_cache)
     stats = {**result.stats, "thickness_distance": distance}
-    return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles)
+    twin = None if result.twin is None else -result.twin  # 1 - ao errs by minus ao's error
+    return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles, twin, result.error)
 
 
 def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,

@@ -255,8 +255,9 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
             reused = sum(e["reused"] for e in job.frame_results)
             frames = f" x {len(request.frames)} frames ({reused} reused, same geometry)"
             dest = frame_pattern(output_path_for(request, obj))
-        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {settings.directions} "
-                     f"directions{frames} in {seconds:.2f} s -> {dest}")
+        error = result.error.text() if result.error is not None else f"{settings.directions} directions"
+        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {error}{frames} in "
+                     f"{seconds:.2f} s -> {dest}")
     if run.gltf_out is not None:
         report.outputs.append(str(run.gltf_out))
     if request.frames:

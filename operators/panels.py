@@ -21,7 +21,11 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         settings = context.scene.hao_bake
         col = layout.column()
         col.prop(settings, "size")
-        col.prop(settings, "directions")
+        col.prop(settings, "quality")
+        col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
+        sub = col.column()
+        sub.active = settings.quality in ("custom", "fixed")
+        sub.prop(settings, "max_error")
         col.prop(settings, "method")
         col.separator()
         col.prop(settings, "max_distance")

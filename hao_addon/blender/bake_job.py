@@ -750,7 +750,8 @@ class BakeJob:
         """One entry per baked object of the last bake (the --json report's objects): its
         triangles, UV map (and whether the job made it), covered texels, the method, shaded
         corners, and where they apply missed texels (Selected to Active), UDIM tiles, the
-        texture set it joined."""
+        texture set it joined; its estimated error (core/bake/error_estimate.py: rmse, p99,
+        directions, capped; None with a single direction)."""
         out = []
         for obj, uv_name, result in self.results:
             st = self.own_stats.get(obj.name, result.stats)
@@ -760,7 +761,8 @@ class BakeJob:
                             smooth_corners=st["smooth_corners"],
                             **({"texture_set": True} if self.request.options.texture_set else {}),
                             **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
-                            **({"udim_tiles": list(result.tiles)} if result.tiles else {})))
+                            **({"udim_tiles": list(result.tiles)} if result.tiles else {}),
+                            error=st.get("error")))
         return out
 
     def label_of(self, obj) -> str:

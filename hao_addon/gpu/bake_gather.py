@@ -32,6 +32,7 @@ from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
                                      normal_bins, octahedral_coords, proximity_order)
 from ..core.errors import BakeInputError
+from ..core.directions import replicate_sizes
 from ..core.bake.estimators import AMBIENT_OCCLUSION, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
@@ -289,8 +290,11 @@ class GatherBaker(LightViewBaker):
         # GatherViews: one buffer per bake, rewritten before each dispatch.
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
-        # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py).
-        self.direction_order = proximity_order(plan.directions)
+        # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py),
+        # each replicate in its own order, one after the other (they are accumulated apart).
+        starts = np.cumsum([0, *replicate_sizes(len(plan.directions))])
+        self.direction_order = np.concatenate([a + proximity_order(plan.directions[a:b])
+                                               for a, b in zip(starts[:-1], starts[1:])])
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
@@ -448,6 +452,12 @@ class GatherBaker(LightViewBaker):
         else:
             needed = np.ones(BIN_COUNT, bool)
         return bin_runs(needed, self.bin_first)
+
+    def restart(self) -> None:
+        """Zero the sums (after accumulated()): the next directions are summed apart."""
+        self._test_pending_views()
+        for accum, fmt in zip(self.accums, ACCUM_FORMATS[self.plan.estimator.channel_count]):
+            accum.clear(format='FLOAT', value=(0.0,) * FORMAT_CHANNELS[fmt])
 
     def _release(self) -> None:
         self.depths = self.depth_fbs = self.dummy = self.views_block = self.facing_batch = self.face_bins = None

@@ -205,6 +205,12 @@ class ScatterBaker(LightViewBaker):
             self.num += (packed & 0xFFFF).astype(np.float64) / self.fixed_scale
             self.pending = 0
 
+    def restart(self) -> None:
+        """Zero the sums (after accumulated()): the next directions are summed apart."""
+        self.flush()
+        self.num[:] = 0.0
+        self.den[:] = 0.0
+
     def accumulated(self) -> np.ndarray:
         """(size, size, 2) float64: the ambient-occlusion estimator's sums (numerator, weight)
         over the directions so far."""

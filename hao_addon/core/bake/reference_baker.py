@@ -139,6 +139,10 @@ class ReferenceBaker:
         """(*plan.output_shape, channels) float64: the estimator's sums per texel (or element)."""
         return texel_sums(self.texel, self.sums, self.plan.output_shape)
 
+    def restart(self) -> None:
+        """Zero the sums (after accumulated()): the next directions are summed apart."""
+        self.sums[:] = 0.0
+
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""
         self.bvh = None

@@ -56,6 +56,15 @@ COLOR_DOMAIN_CHOICES = (
     Choice("point", "Vertex", "one value per vertex: the mean of its face corners (Cycles' point domain)"),
     Choice("corner", "Face Corner", "one value per face corner, shaded with that corner's normal"),
 )
+QUALITY_CHOICES = (
+    Choice("fixed", "Fixed Directions", "exactly Directions (to Max Error instead when that is above 0)"),
+    Choice("draft", "Draft", "to an estimated p99 error of 0.01: a look at the result"),
+    Choice("8-bit", "8-Bit Exact", "to half an 8-bit step (p99 0.00196): no 8-bit value wrong by more than rounding"),
+    Choice("16-bit", "16-Bit", "to an eighth of an 8-bit step (p99 0.00049), for 16-bit and float maps"),
+    Choice("custom", "Custom", "to Max Error"),
+)
+# The p99 error each Quality bakes to (0: none, Directions decide).
+QUALITY_ERRORS = {"fixed": 0.0, "draft": 0.01, "8-bit": 0.5 / 255.0, "16-bit": 0.125 / 255.0, "custom": None}
 SAMPLES_PER_TEXEL_CHOICES = (
     Choice("1", "Off", "one sample at each texel centre"),
     Choice("4", "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
@@ -73,7 +82,16 @@ class BakeSettings:
         subtype='PIXEL', description="width and height of the AO map (also limited by the GPU's texture size)")
     directions: int = setting(
         256, label="Directions", minimum=1, maximum=MAX_DIRECTIONS, soft_max=4096,
-        description="light directions; noise falls as 1/sqrt(directions), time grows linearly")
+        description="light directions (with a Quality or Max Error: at most this many); noise falls about as "
+                    "directions^-0.75, time grows linearly")
+    quality: str = setting(
+        "fixed", label="Quality", choices=QUALITY_CHOICES,
+        description="bake a fixed number of directions, or add them in rounds until the bake's own estimate of "
+                    "its p99 error (99 % of texels within it) reaches a target")
+    max_error: float = setting(
+        0.0, label="Max Error", minimum=0.0, maximum=0.5, soft_max=0.05,
+        description="the p99 error to bake to, with Quality 'custom' or 'fixed' (0 = none: exactly Directions); "
+                    "a bake that reaches Directions first stops there and says so")
     max_distance: float = setting(
         0.0, label="Max Distance", minimum=0.0, soft_max=100.0, unit="scene units",
         subtype='DISTANCE', description="occluders farther than this do not darken; 0 = unlimited")
@@ -174,6 +192,12 @@ class BakeSettings:
         kind = TARGET_KINDS[kind_name(self.target, high_to_low)]
         return abilities_needed(self.max_distance, self.bent_normals, kind, tiled, self.min_distance,
                                 self.spread_cos > 0.0)
+
+    @property
+    def error_target(self) -> float:
+        """The p99 error this bake adds directions until (0: exactly Directions)."""
+        preset = QUALITY_ERRORS[self.quality]
+        return self.max_error if preset is None or (preset == 0.0 and self.max_error > 0.0) else preset
 
     @property
     def spread_cos(self) -> float:
