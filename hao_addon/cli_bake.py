@@ -91,9 +91,9 @@ def _checked_run(args, report: Report) -> _Run:
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
     to_colors = settings.target == "color-attribute"
-    if to_colors and (args.bent_normal_out or args.gltf_out or args.thickness_out or args.orm_out):
+    if to_colors and (args.bent_normal_out or args.gltf_out or args.thickness_out or args.orm_out or args.error_out):
         raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out (.blend, .glb "
-                       "or .ply); --bent-normal-out, --thickness-out, --orm-out and --gltf-out are image bakes")
+                       "or .ply); --bent-normal-out, --thickness-out, --orm-out, --error-out and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
         check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
@@ -102,6 +102,8 @@ def _checked_run(args, report: Report) -> _Run:
         settings = replace(settings, thickness=True)
         check_writable(example_path(args.thickness_out, first_frame), settings.size, settings.size, 1,
                        source=source)
+    if args.error_out:
+        check_writable(example_path(args.error_out, first_frame), settings.size, settings.size, 1, source=source)
     if args.orm_out:
         check_writable(example_path(args.orm_out, first_frame), settings.size, settings.size, 4, source=source)
     gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
@@ -195,6 +197,7 @@ def _request(args, run: _Run, targets: list, high_poly: list | None, cage, group
                        source_path=str(run.source), high_poly=high_poly, cage=cage, groups=groups,
                        bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
                        thickness_filepath=str(Path(os.path.abspath(args.thickness_out))) if args.thickness_out else "",
+                       error_filepath=str(Path(os.path.abspath(args.error_out))) if args.error_out else "",
                        orm_filepath=str(Path(os.path.abspath(args.orm_out))) if args.orm_out else "",
                        wire_material=run.gltf_out is not None,
                        extra_inputs=run.reads + list(getattr(args, "batch_inputs", [])),
@@ -245,6 +248,7 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
             report.outputs.extend(job.files.get((label, "bent"), []))
             report.outputs.extend(job.files.get((label, "thickness"), []))
             report.outputs.extend(job.files.get((label, "orm"), []))
+            report.outputs.extend(job.files.get((label, "error"), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
@@ -297,7 +301,7 @@ def image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
         return []
     return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)"),
             (args.thickness_out or "", "the thickness map (--thickness-out)"),
-            (args.orm_out or "", "the ORM texture (--orm-out)")]
+            (args.orm_out or "", "the ORM texture (--orm-out)"), (args.error_out or "", "the error map (--error-out)")]
 
 
 def has_token(path: str) -> bool:
@@ -318,7 +322,7 @@ def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
     from .blender.paths import input_file_name
     name = input_file_name(path)
-    for option in ("out", "bent_normal_out", "thickness_out", "orm_out", "gltf_out"):
+    for option in ("out", "bent_normal_out", "thickness_out", "orm_out", "error_out", "gltf_out"):
         value = getattr(args, option)
         if value:
             setattr(args, option, value.replace(INPUT_TOKEN, name))

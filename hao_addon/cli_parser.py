@@ -115,6 +115,10 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
                    help="also bake thickness (the occlusion of the inverted hemisphere by the mesh itself within "
                         "--thickness-distance; 1 thin, 0 nothing within reach) into this .png (16-bit) or .exr "
                         "(32-bit float) file; {object} as in --out")
+    b.add_argument("--error-out", default="", metavar="FILE",
+                   help="also write each texel's estimated error (the RMS of the bake's own error estimate over its "
+                        "5 x 5 neighbourhood: one standard error) into this .exr (32-bit float) or .png file; "
+                        "{object} as in --out")
     b.add_argument("--orm-out", default="", metavar="FILE",
                    help="also write glTF's occlusion-roughness-metallic texture: R the AO, G and B the material's "
                         "roughness and metallic (values or image textures) in the baked UV layout, .png (16-bit, "

@@ -18,7 +18,7 @@ from . import __version__
 # local run of the same bake (other paths, a chunk of the frames) share the key, so their
 # files are byte for byte the same.
 NOT_IN_KEY = frozenset({"command", "input", "out", "out_dir", "json", "quiet", "skip_existing", "frames",
-                        "bent_normal_out", "thickness_out", "orm_out", "maps", "gltf_out", "high_poly", "batch_inputs", "batch_outputs", "progress",
+                        "bent_normal_out", "thickness_out", "orm_out", "error_out", "maps", "gltf_out", "high_poly", "batch_inputs", "batch_outputs", "progress",
                         "manifest", "chunk", "input_root"})
 
 
@@ -43,6 +43,7 @@ def run_key(args, input_files: list[Path]) -> str:
     options["bent_normals_file"] = bool(args.bent_normal_out)
     options["thickness_file"] = bool(getattr(args, "thickness_out", ""))
     options["orm_file"] = bool(getattr(args, "orm_out", ""))
+    options["error_file"] = bool(getattr(args, "error_out", ""))
     options["high_poly_names"] = [spec for spec in args.high_poly or () if not Path(spec).is_file()]
     h.update(json.dumps(options, sort_keys=True, default=str).encode())
     return h.hexdigest()

@@ -99,6 +99,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.active = settings.thickness
         sub.prop(settings, "thickness_distance")
         sub.prop(settings, "thickness_filepath")
+        col.prop(settings, "error_filepath")
         outer.prop(settings, "view_samples")
         layout.separator()
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')

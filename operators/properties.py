@@ -49,6 +49,11 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Save Thickness To", description="Also write the thickness map to this .png (16-bit) or .exr file; "
                                               "{object} is replaced by the object's name", default="",
         subtype='FILE_PATH', options=compat.path_property_options())
+    error_filepath: StringProperty(
+        name="Save Error To", description="Also write each texel's estimated error (one standard error, from the "
+                                          "bake's own estimate) to this .exr (float) file; {object} is replaced by "
+                                          "the object's name", default="",
+        subtype='FILE_PATH', options=compat.path_property_options())
     frame_range: BoolProperty(
         name="Frame Range",
         description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
@@ -86,6 +91,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                            high_poly=high_poly, cage=cage,
                            bent_filepath=self.bent_filepath if self.bent_normals else "",
                            thickness_filepath=self.thickness_filepath if self.thickness and to_image else "",
+                           error_filepath=self.error_filepath if to_image else "",
                            frames=self.scene_frames() if self.frame_range else None)
 
     def scene_frames(self) -> list[int]:

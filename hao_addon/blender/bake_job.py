@@ -103,6 +103,7 @@ class BakeRequest:
     cage: "bpy.types.Object | None" = None
     bent_filepath: str = ""
     thickness_filepath: str = ""  # settings.thickness: the thickness map's file (tokens as filepath)
+    error_filepath: str = ""  # the estimated error per texel (BakeResult.error_map), a float image
     # glTF's occlusion-roughness-metallic texture (core/bake/orm.py) to this file (tokens as
     # filepath); with wire_material it replaces the AO in the material's glTF wiring.
     orm_filepath: str = ""
@@ -199,6 +200,9 @@ def validate_request(request: BakeRequest) -> None:
     if request.orm_filepath and (request.to_color_attribute or request.options.texture_set):
         raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
                              "texture set)")
+    if request.error_filepath and request.to_color_attribute:
+        raise BakeInputError("an error map is an image of the UV layout: a colour-attribute bake reports its error "
+                             "(--json) but has no error map")
     if request.thickness_filepath and not request.settings.thickness:
         raise BakeInputError("a thickness file needs the Thickness setting on")
     if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
@@ -224,7 +228,8 @@ def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
     """The image files a request writes per target: (kind, path pattern, what, channels)."""
     return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4),
             ("thickness", request.thickness_filepath, "the thickness map", 1),
-            ("orm", request.orm_filepath, "the ORM texture", 4))
+            ("orm", request.orm_filepath, "the ORM texture", 4),
+            ("error", request.error_filepath, "the error map", 1))
 
 
 def _file_owners(request: BakeRequest) -> list:
@@ -698,7 +703,8 @@ class BakeJob:
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
                         maps = {"ao": result.ao, "bent": self.bent_images.get(label),
-                                "thickness": self.thickness_maps.get(label), "orm": self.orm_images.get(label)}[kind]
+                                "thickness": self.thickness_maps.get(label), "orm": self.orm_images.get(label),
+                                "error": result.error_map()}[kind]
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):

@@ -105,7 +105,7 @@ def local_rms(twin: np.ndarray, covered: np.ndarray, radius: int = NEIGHBOURHOOD
     square = np.where(covered, twin.astype(np.float64) ** 2, 0.0)
     count = _box_sum(covered.astype(np.float64), radius)
     mean = np.divide(_box_sum(square, radius), count, out=np.zeros_like(square), where=count > 0)
-    return np.sqrt(mean).astype(np.float32)
+    return np.sqrt(np.maximum(mean, 0.0)).astype(np.float32)  # box sums by differences: -1e-20 is 0
 
 
 def converged(twin: np.ndarray, covered: np.ndarray, max_error: float) -> np.ndarray:
