@@ -192,9 +192,9 @@ def test_gather_normal_bins_skip_entries_without_changing_the_map(gpu_context, m
         sphere.normals = sphere.positions - np.array([0.0, 0.0, 1.0])
     # A closed scene (the depth maps cull back faces): the sphere over a box.
     box = scenes.box((-3.0, -3.0, -1.0), (3.0, 3.0, -0.05))
-    settings = BakeSettings(size=64, directions=32, method="gather", margin=0)
-    # Batches of 4 of the 32 directions: 16 directions span half the sphere, and nearly every
-    # bin faces one of them.
+    settings = BakeSettings(size=64, directions=64, method="gather", margin=0)
+    # Batches of 4 of a replicate's 32 directions (core/directions.py): 16 directions span half
+    # the sphere, and nearly every bin faces one of them.
     monkeypatch.setattr(bake_gather, "VIEWS_PER_DISPATCH", 4)
     maps, stats = [], []
     for binning in (True, False):
@@ -237,20 +237,27 @@ def test_wendland_falloff_is_the_papers_kernel(gpu_context, method):
 def test_every_baker_returns_the_estimators_sums(gpu_context, method):
     """The bakers find visibility their own way and return the plan's estimator sums per texel
     (core/bake/estimators.py): (size, size, channels), the weight sum last; for ambient
-    occlusion the map is their ratio and the numerator never exceeds the weight sum."""
+    occlusion the map is their ratio and the numerator never exceeds the weight sum. The bake
+    sums its two replicates apart (restart between them) and adds them."""
     from hao_addon.bakers import baker_for
     from hao_addon.core.bake.estimators import AMBIENT_OCCLUSION
     from hao_addon.core.bake.plan import make_plan
     from hao_addon.core.bake.seams import finalize_map
+    from hao_addon.core.directions import replicate_sizes
     plane, sphere = sphere_on_plane()
     settings = BakeSettings(size=32, directions=16, method=method, margin=0)
     plan = make_plan(plane, [sphere], settings)
     assert plan.estimator is AMBIENT_OCCLUSION
     baker = baker_for(method)(plan)
     try:
-        for i in range(settings.directions):
+        split = replicate_sizes(settings.directions)[0]
+        for i in range(split):
             baker.run_direction(i)
-        sums = baker.accumulated()
+        first = baker.accumulated()
+        baker.restart()
+        for i in range(split, settings.directions):
+            baker.run_direction(i)
+        sums = first + baker.accumulated()
     finally:
         baker.free()
     assert sums.shape == (32, 32, AMBIENT_OCCLUSION.channel_count)

@@ -70,7 +70,8 @@ def test_object_token_and_json_report(dirs):
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
-                                    smooth_corners=0)]  # spot.obj has no 's' groups: flat
+                                    smooth_corners=0, error=data["objects"][0]["error"])]  # no 's' groups: flat
+    assert data["objects"][0]["error"]["directions"] == 8 and not data["objects"][0]["error"]["capped"]
     assert data["settings"]["size"] == 64 and data["settings"]["view_samples"] == 2.0
     # An OBJ carries no terminator offset of its own: --terminator-offset (default 0.1) applies.
     assert data["settings"]["terminator"] == "setting" and data["settings"]["terminator_offset"] == 0.1
