@@ -36,24 +36,15 @@ import shading_scenes as cases  # noqa: E402
 import hao_addon.bake as bake_module  # noqa: E402
 import hao_addon.core.directions as directions_module  # noqa: E402
 from hao_addon.bake import bake  # noqa: E402
-from hao_addon.blender import mesh_data  # noqa: E402
 from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
-from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
 
 MESHES = ["rocker_smooth", "spot_smooth"]
 TARGET = 0.5 / 255.0
 
 
 def load(name):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    truth = np.load(cases.truth_path(name))
-    uvs = truth["uvs"].astype(np.float64)
-    obj = cases.build_object(name, uvs)
-    soup = mesh_data.evaluated_soup(obj, bpy.context.evaluated_depsgraph_get(), "UVMap", shading_normals=True)
-    face, _b, hits = texel_surface_samples(uvs, cases.TRUTH_SIZE)
-    a, b = truth["ao"].astype(np.float64), truth["ao_seed1"].astype(np.float64)
-    return soup, 0.5 * (a + b), (a - b) ** 2 / 4.0, interior_mask(face, hits)
+    return cases.evaluated_case(name)
 
 
 def gather(soup, name, directions, seed=0, **kw):

@@ -142,3 +142,19 @@ def build_high_to_low(name: str, low: tuple[np.ndarray, np.ndarray, np.ndarray])
     high = _smooth_object(name + "_high", v, t)
     low_obj = _smooth_object(name + "_low", *low)
     return low_obj, high
+
+
+def evaluated_case(name: str):
+    """(the case's evaluated soup with its shading normals, the mean of Cycles' two bakes
+    (256, 256), that mean's noise variance per texel (256, 256), the interior texels (256, 256))
+    in a fresh scene: what a calibration against Cycles needs."""
+    from hao_addon.blender import mesh_data
+    from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    truth = np.load(truth_path(name))
+    uvs = truth["uvs"].astype(np.float64)
+    obj = build_object(name, uvs)
+    soup = mesh_data.evaluated_soup(obj, bpy.context.evaluated_depsgraph_get(), "UVMap", shading_normals=True)
+    face, _bary, hits = texel_surface_samples(uvs, TRUTH_SIZE)
+    a, b = truth["ao"].astype(np.float64), truth["ao_seed1"].astype(np.float64)
+    return soup, 0.5 * (a + b), (a - b) ** 2 / 4.0, interior_mask(face, hits)

@@ -12,19 +12,16 @@ import json
 import subprocess
 import sys
 
-import bpy
 import numpy as np
 import pytest
 
 import shading_scenes as cases
 from bake_helpers import texel_points
 from hao_addon.bake import bake
-from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.bake import error_estimate as ee
 from hao_addon.core.bake.abilities import bakers_with
 from hao_addon.core.bake.settings import BakeSettings, QUALITY_ERRORS
-from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 from hao_addon.core.directions import bake_directions, replicate_sizes
 
 ROOT = cases.ROOT
@@ -111,14 +108,7 @@ def test_estimate_matches_the_error_against_the_analytic_sphere_on_a_plane(gpu_c
 
 
 def _smooth_case(name):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    truth = np.load(cases.truth_path(name))
-    uvs = truth["uvs"].astype(np.float64)
-    obj = cases.build_object(name, uvs)
-    soup = mesh_data.evaluated_soup(obj, bpy.context.evaluated_depsgraph_get(), "UVMap", shading_normals=True)
-    face, _bary, hits = texel_surface_samples(uvs, cases.TRUTH_SIZE)
-    a, b = truth["ao"].astype(np.float64), truth["ao_seed1"].astype(np.float64)
-    return soup, 0.5 * (a + b), (a - b) ** 2 / 4.0, interior_mask(face, hits)
+    return cases.evaluated_case(name)
 
 
 def _gather(soup, name, directions, seed=0, **kw):
