@@ -130,7 +130,7 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
         yield 1.0
         stats = {**cached.stats, "cache_hit": True, "target_name": target.name,
                  "warnings": _renamed(cached.stats.get("warnings", []), cached.stats.get("target_name"), target.name)}
-        return BakeResult(cached.ao, cached.covered, cached.filled, stats, cached.bent_normals, cached.tiles)
+        return replace(cached, stats=stats)
     # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
     with single_threaded_blas() as blas_threads:
         if settings.error_target > 0.0:
@@ -146,9 +146,11 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
     return result
 
 
-def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings
-                   ) -> Generator[float, None, BakeResult]:
-    """bake_steps without its cache: plan, run the baker's directions, finish the output."""
+def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
+                   shared: dict | None = None) -> Generator[float, None, BakeResult]:
+    """bake_steps without its cache: plan, run the baker's directions, finish the output.
+    shared: kept across the rounds of a bake to an error; the Selected-to-Active projection
+    is stored there and reused (BakePlan.projection)."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     projects = target.high_to_low is not None
     method = settings.method_for(projects)
@@ -156,7 +158,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     # The method's own ray cast (an unknown method is refused by the plan's validation).
     cast = ray_caster_for(method) if projects and method in BAKE_METHODS else None
     cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
-    planning = make_plan_steps(target, occluders, settings, cast=cast)
+    shared = {} if shared is None else shared
+    planning = make_plan_steps(target, occluders, settings, cast=cast, projection=shared.get("projection"))
     try:
         while True:
             try:
@@ -167,6 +170,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             yield share * fraction
     finally:
         planning.close()  # cancelled during the projection: stop it there
+    shared["projection"] = plan.projection
     method = choose_method(settings.method, plan.abilities_needed)
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
@@ -221,12 +225,12 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     rounds are averaged weighted by their directions, and so are their twins (independent
     rounds: the union's twin is still a draw of the union's error)."""
     target_error, cap = settings.error_target, settings.directions
-    results, history, skippable = [], [], 0.0
+    results, history, skippable, shared = [], [], 0.0, {}
     size, done, shown = min(cap, PILOT_DIRECTIONS), 0, 0.0
     while size > 0:
         round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
                                  seed=(settings.seed + 7919 * len(results)) % 2**31)
-        steps = _bake_uncached(target, occluders, round_settings)
+        steps = _bake_uncached(target, occluders, round_settings, shared)
         try:
             while True:
                 try:

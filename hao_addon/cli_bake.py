@@ -10,7 +10,7 @@ from pathlib import Path
 from .cli_errors import CLIError
 from .cli_io import check_signals, deferred_signals, Progress, REPORT, Report
 from .cli_options import option_for, settings_from_args
-from .cli_parser import INPUT_FORMATS
+from .cli_parser import IMAGE_OPTIONS, INPUT_FORMATS
 from .cli_scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
                         export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
 from .core.frame_ranges import parse_frames
@@ -91,9 +91,10 @@ def _checked_run(args, report: Report) -> _Run:
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
     to_colors = settings.target == "color-attribute"
-    if to_colors and (args.bent_normal_out or args.gltf_out or args.thickness_out or args.orm_out or args.error_out):
+    if to_colors and (args.gltf_out or any(getattr(args, option) for option in IMAGE_OPTIONS)):
+        options = ", ".join("--" + option.replace("_", "-") for option in IMAGE_OPTIONS)
         raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out (.blend, .glb "
-                       "or .ply); --bent-normal-out, --thickness-out, --orm-out, --error-out and --gltf-out are image bakes")
+                       f"or .ply); {options} and --gltf-out are image bakes")
     if args.bent_normal_out:
         settings = replace(settings, bent_normals=True)
         check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
@@ -322,7 +323,7 @@ def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
     from .blender.paths import input_file_name
     name = input_file_name(path)
-    for option in ("out", "bent_normal_out", "thickness_out", "orm_out", "error_out", "gltf_out"):
+    for option in ("out", *IMAGE_OPTIONS, "gltf_out"):
         value = getattr(args, option)
         if value:
             setattr(args, option, value.replace(INPUT_TOKEN, name))

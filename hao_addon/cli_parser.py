@@ -62,7 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # --maps: each map's own output option (argparse dest), its file named after --out with _MAP.
-MAP_OUTPUTS = {"ao": "", "bent-normal": "bent_normal_out", "thickness": "thickness_out", "orm": "orm_out"}
+MAP_OUTPUTS = {"ao": "", "bent-normal": "bent_normal_out", "thickness": "thickness_out", "orm": "orm_out",
+               "error": "error_out"}
+# The image options besides --out (each an image bake: not with a colour attribute).
+IMAGE_OPTIONS = tuple(option for option in MAP_OUTPUTS.values() if option)
 
 
 def add_bake_arguments(b: argparse.ArgumentParser) -> None:

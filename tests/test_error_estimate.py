@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ import shading_scenes as cases
 from bake_helpers import texel_points
 from hao_addon.bake import bake
 from hao_addon.core import scenes
+from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.bake import error_estimate as ee
 from hao_addon.core.bake.abilities import bakers_with
 from hao_addon.core.bake.settings import BakeSettings, QUALITY_ERRORS
@@ -181,3 +183,53 @@ def test_cli_reports_the_error_and_writes_the_error_map(tmp_path):
     from bake_helpers import load_image_rgba
     err = load_image_rgba(tmp_path / "err.exr")[..., 0]
     assert 0.0 < err.max() < 0.5 and np.isfinite(err).all()
+
+
+def _udim(soup):
+    """The soup's UVs halved and its second half of faces moved to tile 1002."""
+    uvs = soup.uvs * 0.5
+    uvs[len(uvs) // 2:, :, 0] += 1.0
+    return TriangleSoup(soup.positions, uvs, soup.name, soup.normals)
+
+
+@pytest.mark.parametrize("target, method", [("texels", "scatter"), ("texels", "gather"), ("udim", "gather"),
+                                            ("corners", "gather"), ("projected", "gather"),
+                                            pytest.param("texels", "reference", marks=pytest.mark.release_independent)])
+def test_every_target_bakes_to_a_stated_error(gpu_context, monkeypatch, target, method):
+    """A sphere over a floor to a p99 of 0.03 on every target kind and method that can bake it:
+    more than one round, the estimate within the target and not capped. Selected to Active
+    casts its projection once for all rounds (the rounds differ only in their directions)."""
+    import hao_addon.core.bake.plan as plan_module
+    from hao_addon.core.bake.projection import HighToLow
+    from hao_addon.core.bake.vertex_target import indexed_vertex_target
+    casts = []
+    original = plan_module.projected_receivers_steps
+
+    def counted(*args):
+        casts.append(1)
+        return (yield from original(*args))
+
+    monkeypatch.setattr(plan_module, "projected_receivers_steps", counted)
+    floor, ball = scenes.grid_plane(4.0, 8, name="floor"), scenes.uv_sphere(0.6, (0, 0, 0.6), 24, 12, name="ball")
+    size = 24 if method == "reference" else 96
+    settings = BakeSettings(size=size, directions=4096, method=method, margin=0, max_error=0.03,
+                            max_distance=2.0 if method == "scatter" else 0.0)
+    kwargs, receiver, occluders = {}, floor, [ball]
+    if target == "udim":
+        receiver = _udim(floor)
+    elif target == "corners":
+        verts, index = np.unique(floor.positions.reshape(-1, 3).round(9), axis=0, return_inverse=True)
+        kwargs["vertex_target"] = indexed_vertex_target(index.reshape(-1, 3), len(verts))
+        receiver = TriangleSoup(floor.positions, None, "floor")
+        settings = replace(settings, target="color-attribute")
+    elif target == "projected":
+        receiver, occluders = scenes.grid_plane(4.0, 2, z=0.01, name="low"), []
+        kwargs["high_to_low"] = HighToLow([floor, ball])
+        settings = replace(settings, max_ray_distance=0.05)
+    res = bake(receiver, occluders, settings, use_cache=False, **kwargs)
+    st = res.stats
+    assert len(st["rounds"]) >= 2 and not res.error.capped and res.error.p99 <= 0.03, st["rounds"]
+    assert res.twin.shape == res.ao.shape and res.error.directions == sum(st["rounds"])
+    if target == "udim":
+        assert res.tiles == (1001, 1002)
+    assert len(casts) == (1 if target == "projected" else 0)

@@ -92,6 +92,9 @@ class BakePlan:
     kind: TargetKind = TARGET_KINDS["texels"]
     # What lets light through, per drawn face (core/bake/alpha.py), or None: all opaque.
     alpha: DrawnAlpha | None = None
+    # Selected to Active: the projection's (receivers, stats, warning), which no direction or
+    # seed changes: the rounds of a bake to an error pass it on (make_plan_steps' projection).
+    projection: tuple | None = None
 
     def receivers(self) -> Receivers:
         """The bake's receivers: the projected high-poly points, the target's face corners
@@ -250,9 +253,12 @@ def make_plan(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], 
 
 def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                     high_to_low: HighToLow | None = None, cast: RayCast | None = None,
-                    vertex_target: VertexTarget | None = None) -> Generator[float, None, BakePlan]:
+                    vertex_target: VertexTarget | None = None, projection: tuple | None = None
+                    ) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
-    without high_to_low): its seconds of ray casting can be drawn and cancelled."""
+    without high_to_low): its seconds of ray casting can be drawn and cancelled. projection:
+    an earlier plan's (BakePlan.projection) of the same target, sources and settings but for
+    directions and seed, used instead of casting again."""
     settings = settings.validated()
     bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
     bake_target.check(settings.bent_normals)
@@ -293,8 +299,9 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     projected, projection_stats = None, {}
     extent = 1.0  # radius of the receivers' sphere about the origin, normalized
     if high_to_low is not None:
-        projected, projection_stats, warning = yield from projected_receivers_steps(
-            target, high_to_low, settings, centre, scale, cast, udim)
+        if projection is None:
+            projection = yield from projected_receivers_steps(target, high_to_low, settings, centre, scale, cast, udim)
+        projected, projection_stats, warning = projection
         uv_warnings = uv_warnings + ([warning] if warning else [])
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))
@@ -385,7 +392,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, vertex_target, udim, stats, kind, alpha)
+                    closed, holes, projected, vertex_target, udim, stats, kind, alpha, projection)
 
 
 def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:
