@@ -177,18 +177,9 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     baker = baker_cls(plan)
     try:
         count = settings.directions
-        split = replicate_sizes(count)[0]  # the second replicate's first direction
-        sums_a = None
-        for i in range(count):
-            if i == split:  # each replicate summed apart (core/bake/error_estimate.py)
-                sums_a = baker.accumulated()
-                baker.restart()
-            baker.run_direction(i)
-            yield share + (1.0 - share) * (i + 1) / count
-        sums = baker.accumulated()
-        sums_b = None
-        if sums_a is not None:  # the map is the replicates' mean (each receiver weighs 1 in each)
-            sums, sums_b = sums_a + sums, sums
+        sums_a, sums_b = yield from replicate_sums_steps(baker, count, share)
+        # The map is the replicates' mean (each receiver weighs 1 in each).
+        sums = sums_b if sums_a is None else sums_a + sums_b
         gpu_stats = dict(baker.stats)
     finally:
         baker.free()
@@ -215,6 +206,21 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
              "cache_hit": False, "error": None if error is None else error.as_dict()}
     tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
     return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error)
+
+
+def replicate_sums_steps(baker, count: int, start: float = 0.0) -> Generator[float, None, tuple]:
+    """Run a baker's `count` directions, each replicate summed apart (core/bake/error_estimate.py):
+    (the first replicate's sums or None when there is one, the last one's), each
+    (*plan.output_shape, channels). Yields progress from start to 1."""
+    split = replicate_sizes(count)[0]  # the second replicate's first direction
+    sums_a = None
+    for i in range(count):
+        if i == split:
+            sums_a = baker.accumulated()
+            baker.restart()
+        baker.run_direction(i)
+        yield start + (1.0 - start) * (i + 1) / count
+    return sums_a, baker.accumulated()
 
 
 def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings

@@ -84,12 +84,14 @@ def main(argv: list[str] | None = None) -> int:
                     io.err.write(f"hao: warning: {warning}\n")
                 if args.json != "-":
                     io.out.write("".join(line + "\n" for line in lines))
-            for failed in report.input_errors:  # a batch's failed inputs, one line each
+            for failed in report.input_errors + report.check_failures:  # one line each
                 io.err.write(f"hao: error: {failed}\n")
-            code = EXIT_FAILURE if report.input_errors else EXIT_OK
+            code = EXIT_FAILURE if report.input_errors or report.check_failures else EXIT_OK
             if report.input_errors:
                 report.status = "partial"
                 report.error = f"{len(report.input_errors)} of {len(report.inputs)} inputs failed"
+            elif report.check_failures:
+                report.status, report.error = "check-failed", "; ".join(report.check_failures)
             else:
                 report.mark_done()
         except SystemExit as exc:  # --help / --version

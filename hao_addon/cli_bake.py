@@ -263,6 +263,12 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
         error = result.error.text() if result.error is not None else f"{settings.directions} directions"
         lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {error}{frames} in "
                      f"{seconds:.2f} s -> {dest}")
+    bound = run.options.verify_max_error
+    for label, check in job.verifications:
+        lines.append(f"hao: '{label}' {check.text()}")
+        if bound > 0.0 and check.misses(bound):
+            report.check_failures.append(f"'{label}': the verification puts the map's p99 error at {check.p99[1]:.2g} "
+                                         f"(95 % from {check.p99[0]:.2g}), above --verify-max-error {bound:g}")
     if run.gltf_out is not None:
         report.outputs.append(str(run.gltf_out))
     if request.frames:

@@ -56,6 +56,9 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
         try:
             lines += run_bake(sub, one, progress)
             one.mark_done()
+            if one.check_failures:  # baked and written, but its verification failed
+                one.status, one.exit_code, one.error = "check-failed", 1, "; ".join(one.check_failures)
+                report.check_failures.extend(f"{path}: {failure_line}" for failure_line in one.check_failures)
         except (KeyboardInterrupt, Terminated):
             raise
         except BaseException as exc:  # noqa: BLE001 - one input's failure is its line, the batch goes on

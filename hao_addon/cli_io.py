@@ -233,6 +233,9 @@ class Report:
     # A batch: one report per input (as_dict), and the failed ones' lines.
     inputs: list = field(default_factory=list)
     input_errors: list = field(default_factory=list)
+    # Checks of finished bakes that failed (--verify-max-error): the maps are written, the run
+    # exits 1 with one line each.
+    check_failures: list = field(default_factory=list)
     # A frame sequence: per frame {frame, seconds, reused, outputs} (skipped: true for a frame
     # --skip-existing found current).
     frames: list = field(default_factory=list)

@@ -110,6 +110,11 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
     def _report_done(self, job: BakeJob) -> None:
         for note in job.request.notes:
             self.report({'WARNING'}, note)
+        bound = job.request.options.verify_max_error
+        for label, check in job.verifications:  # --verify: the map against the reference
+            missed = bound > 0.0 and check.misses(bound)
+            self.report({'ERROR'} if missed else {'INFO'}, f"'{label}' {check.text()}"
+                        + (f": above Verify Max Error {bound:g}" if missed else ""))
         for _obj, _uv, result in job.results:
             for warning in result.stats.get("warnings", []):
                 self.report({'WARNING'}, warning)

@@ -100,6 +100,10 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         sub.prop(settings, "thickness_distance")
         sub.prop(settings, "thickness_filepath")
         col.prop(settings, "error_filepath")
+        col.prop(settings, "verify")
+        sub = col.column()
+        sub.active = settings.verify > 0
+        sub.prop(settings, "verify_max_error")
         outer.prop(settings, "view_samples")
         layout.separator()
         layout.operator("object.hao_bake_ao", icon='RENDER_STILL')

@@ -23,6 +23,8 @@ import numpy as np
 
 from .. import compat
 from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
+from ..core.bake.error_estimate import estimate
+from ..verify import verify_steps
 from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
 from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
@@ -382,6 +384,8 @@ class BakeJob:
         self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
         self.thickness_maps: dict[str, np.ndarray] = {}  # object name -> (size, size) thickness
         self.own_stats: dict[str, dict] = {}  # bake groups in a texture set: each low-poly's own bake's stats
+        # --verify: (label, Verification) of each verified bake (hao_addon/verify.py).
+        self.verifications: list[tuple[str, object]] = []
         self.orm_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) ORM texture
         self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
@@ -556,6 +560,13 @@ class BakeJob:
                            f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%")
             finally:
                 gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
+            if req.options.verify:
+                check = yield from _with_status(verify_steps(target, occluders, settings, result, req.options.verify),
+                                                start + share * (k + 1) / len(units),
+                                                f"Verifying '{label}'{at} against the reference")
+                if check is not None:
+                    result = replace(result, stats={**result.stats, "verify": check.as_dict()})
+                    self.verifications.append((label, check))
             if settings.thickness:
                 steps = thickness_steps(soup, settings, use_cache=frame is None)
                 thick = yield from _with_status(steps, start + share * (k + 1) / len(units),
@@ -580,14 +591,18 @@ class BakeJob:
         results = [result for _o, _uv, result in self.results]
         first = results[0]
         ao, covered, filled = first.ao.copy(), first.covered.copy(), first.filled.copy()
+        twin = None if any(r.twin is None for r in results) else first.twin.copy()
         for result in results[1:]:
             new = result.filled & ~filled
             ao[new] = result.ao[new]
+            if twin is not None:
+                twin[new] = result.twin[new]
             covered |= result.covered
             filled |= result.filled
-        stats = {**first.stats, "covered_texels": int(covered.sum()),
+        error = None if twin is None else estimate(twin, covered, max(r.error.directions for r in results))
+        stats = {**first.stats, "covered_texels": int(covered.sum()), "error": error and error.as_dict(),
                  "warnings": [w for r in results for w in r.stats.get("warnings", [])]}
-        merged = BakeResult(ao, covered, filled, stats, None, first.tiles)
+        merged = BakeResult(ao, covered, filled, stats, None, first.tiles, twin, error)
         self.own_stats = {obj.name: result.stats for obj, _uv, result in self.results}
         self.results = [(obj, uv, merged) for obj, uv, _r in self.results]
 
@@ -768,7 +783,7 @@ class BakeJob:
                             **({"texture_set": True} if self.request.options.texture_set else {}),
                             **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
                             **({"udim_tiles": list(result.tiles)} if result.tiles else {}),
-                            error=st.get("error")))
+                            error=st.get("error"), **({"verify": st["verify"]} if "verify" in st else {})))
         return out
 
     def label_of(self, obj) -> str:

@@ -69,6 +69,17 @@ class JobOptions:
         "group", label="Group Occluders", choices=GROUP_OCCLUDER_CHOICES,
         description="Match Names: which meshes occlude a group (Occluders does not apply)")
 
+    verify: int = setting(
+        0, label="Verify Texels", noun="verified texels", minimum=0, maximum=100000,
+        description="after the bake, re-estimate this many random covered texels (seeded by Seed) with the CPU "
+                    "reference at 4096 directions, and report the map's RMSE, p99 and bias against it with 95 % "
+                    "intervals (what the reference shares with the bake: the same surface points, normals and "
+                    "estimator); 0 = off")
+    verify_max_error: float = setting(
+        0.0, label="Verify Max Error", minimum=0.0, maximum=0.5,
+        description="with Verify Texels: the run fails (exit 1) when the verification's 95 % interval puts the "
+                    "map's p99 error above this; the maps are written either way; 0 = no bound")
+
     @property
     def png_bit_depth(self) -> int:
         return int(self.png_bits)
@@ -76,6 +87,8 @@ class JobOptions:
     def validated(self) -> "JobOptions":
         """Return self, or raise SettingError naming the option."""
         validate(self)
+        if self.verify_max_error > 0.0 and self.verify == 0:
+            raise SettingError("verify_max_error", "verify max error checks a verification: add --verify N (texels)")
         if self.dither and self.png_bits != "8":
             raise SettingError("dither", "dither applies to 8-bit PNG files: add --png-bits 8")
         if self.match_names and (not self.low_suffix or not self.high_suffix

@@ -60,10 +60,15 @@ class ReferenceBaker:
                 f"(size^2 x samples per texel x directions), "
                 f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
 
-    def __init__(self, plan: BakePlan) -> None:
+    def __init__(self, plan: BakePlan, cells: np.ndarray | None = None) -> None:
+        """cells: flat output indices (texels, tiles' texels or elements) to trace alone (a
+        verification's sample; core/bake/verify.py), or None for all."""
         self.plan = plan
         receivers = plan.receivers()
-        receivers = receivers.subset(receivers.inv_s > 0.0)
+        keep = receivers.inv_s > 0.0
+        if cells is not None:
+            keep &= np.isin(receivers.texel, cells)
+        receivers = receivers.subset(keep)
         self.texel = receivers.texel
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
         self.geometric = receivers.geometric
