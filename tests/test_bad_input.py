@@ -213,6 +213,8 @@ CASES = [
                                 "--error-out", "{out}/e.exr"], 2, "--error-out and --gltf-out are image bakes"),
     ("max-error-range", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--max-error", "0.7"], 2,
      "--max-error"),
+    ("verify-bound-without-verify", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--verify-max-error", "0.01"], 2,
+     "add --verify N"),
     ("maps-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "ao,curvature"], 2,
      "--maps: unknown map 'curvature'"),
     ("dither-16-bit", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--dither"], 2, "add --png-bits 8"),
