@@ -25,9 +25,9 @@ from .core.bake.estimators import BENT_NORMALS
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
     replicate_twin
 from .core.directions import replicate_sizes
-from .core.bake.seams import element_values, finalize_map, finalize_vectors
+from .core.bake.seams import dilate, element_values, finalize_map, finalize_vectors
 from .core.bake.settings import BakeSettings
-from .core.bake.abilities import check_method, choose_method
+from .core.bake.abilities import check_method, choose_method, declaration
 from .core.bake.targets import BakeTarget, as_bake_target
 from .core.bake.vertex_target import VertexTarget
 
@@ -150,7 +150,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
                    shared: dict | None = None) -> Generator[float, None, BakeResult]:
     """bake_steps without its cache: plan, run the baker's directions, finish the output.
     shared: kept across the rounds of a bake to an error; the Selected-to-Active projection
-    is stored there and reused (BakePlan.projection)."""
+    is stored there and reused (BakePlan.projection), and the caller puts the cells a round
+    bakes there (BakePlan.cells)."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     projects = target.high_to_low is not None
     method = settings.method_for(projects)
@@ -159,7 +160,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     cast = ray_caster_for(method) if projects and method in BAKE_METHODS else None
     cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
     shared = {} if shared is None else shared
-    planning = make_plan_steps(target, occluders, settings, cast=cast, projection=shared.get("projection"))
+    planning = make_plan_steps(target, occluders, settings, cast=cast, projection=shared.get("projection"),
+                               cells=shared.get("cells"))
     try:
         while True:
             try:
@@ -227,15 +229,19 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
                    ) -> Generator[float, None, BakeResult]:
     """Rounds of whole bakes, each with its own direction set, until the estimated p99 of their
     union is within settings.error_target or settings.directions are spent (capped). Each
-    round's size is predicted from the error so far (core/bake/error_estimate.next_round); the
-    rounds are averaged weighted by their directions, and so are their twins (independent
-    rounds: the union's twin is still a draw of the union's error)."""
+    round's size is predicted from the error so far (core/bake/error_estimate.next_round).
+    After the first, a round bakes only the texels that have not converged, where its method
+    can (abilities.bakes_all_cells); each texel is the mean of the rounds that baked it,
+    weighted by their directions, and so is its twin (independent rounds: still a draw of its
+    error)."""
     target_error, cap = settings.error_target, settings.directions
-    results, history, skippable, shared = [], [], 0.0, {}
-    size, done, shown = min(cap, PILOT_DIRECTIONS), 0, 0.0
+    rounds, history, shared = [], [], {}
+    work = skipped = 0.0  # texel x direction pairs: all of them, and those left out
+    size, done, shown, cells, skips = min(cap, PILOT_DIRECTIONS), 0, 0.0, None, True
     while size > 0:
         round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
-                                 seed=(settings.seed + 7919 * len(results)) % 2**31)
+                                 seed=(settings.seed + 7919 * len(rounds)) % 2**31)
+        shared["cells"] = cells if skips else None
         steps = _bake_uncached(target, occluders, round_settings, shared)
         try:
             while True:
@@ -248,20 +254,26 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
                 yield shown
         finally:
             steps.close()
-        if results and results[-1][1].twin is not None:  # what a texel-skipping method would not bake
-            skippable += size * float(converged(combined.twin, combined.covered, target_error).sum()) / max(
-                1, int(combined.covered.sum()))
-        results.append((size, part))
+        skips = not declaration(part.stats["method"]).bakes_all_cells
+        rounds.append((size, part))
         done += size
-        combined = _combine_rounds(results)
+        combined = _combine_rounds(rounds, settings.margin)
         if combined.error is None:
             break
         history.append((done, combined.error.p99))
         size = next_round(history, target_error, cap)
+        if size:  # the texels the next round needs: those not yet converged (all if none is)
+            active = combined.covered & ~converged(combined.twin, combined.covered, target_error)
+            cells = np.flatnonzero(active) if active.any() else None
+            work += size * float(combined.covered.sum())
+            skipped += 0.0 if cells is None else size * float(combined.covered.sum() - active.sum())
     capped = combined.error is not None and combined.error.p99 > target_error
     error = None if combined.error is None else replace(combined.error, capped=capped)
+    method = rounds[0][1].stats["method"]
     stats = {**combined.stats, "error": None if error is None else error.as_dict(), "error_target": target_error,
-             "rounds": [n for n, _r in results], "skippable_fraction": skippable / max(done, 1)}
+             "rounds": [n for n, _r in rounds], "skippable_fraction": skipped / work if work else 0.0,
+             "skipped_converged": skips and skipped > 0.0,
+             **({"bakes_all_cells": declaration(method).bakes_all_cells} if not skips else {})}
     if capped:
         stats["warnings"] = [*stats.get("warnings", []),
                              f"'{target.name}': the estimated p99 error {error.p99:.2g} is above the target "
@@ -269,26 +281,48 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     return replace(combined, stats=stats, error=error)
 
 
-def _combine_rounds(results: list[tuple[int, BakeResult]]) -> BakeResult:
-    """The rounds' union: maps, bent normals and twins averaged weighted by directions."""
-    total = sum(n for n, _r in results)
-    last = results[-1][1]
-    if len(results) == 1:
-        return last
-    covered = np.logical_and.reduce([r.covered for _n, r in results])
-    filled = np.logical_and.reduce([r.filled for _n, r in results])
-    ao = (sum(n * r.ao.astype(np.float64) for n, r in results) / total).astype(np.float32)
+def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeResult:
+    """The rounds' union: each covered texel (or element) the mean of the rounds that covered
+    it, weighted by their directions, and so its bent normal and twin; margins grown again from
+    the new values as the first round grew them (seams.dilate)."""
+    first, last = rounds[0][1], rounds[-1][1]
+    if len(rounds) == 1:
+        return first
+    weight = sum(n * r.covered for n, r in rounds).astype(np.float64)
+    covered = weight > 0.0
+
+    def mean(field):
+        total = sum(n * np.where(r.covered.reshape(r.covered.shape + (1,) * (field(r).ndim - r.covered.ndim)),
+                                 field(r).astype(np.float64), 0.0) for n, r in rounds)
+        w = weight.reshape(weight.shape + (1,) * (total.ndim - weight.ndim))
+        return np.divide(total, w, out=np.zeros_like(total), where=w > 0.0)
+
+    ao = _regrown(mean(lambda r: r.ao).astype(np.float32), covered, first, margin)
     bent = None
     if last.bent_normals is not None:
-        mean = sum(n * r.bent_normals.astype(np.float64) for n, r in results)
-        length = np.linalg.norm(mean, axis=-1, keepdims=True)
-        bent = np.divide(mean, length, out=np.zeros_like(mean), where=length > 0).astype(np.float32)
+        tiles = mean(lambda r: r.bent_normals)
+        bent = (finalize_vectors(tiles, covered, first.filled, margin) if tiles.ndim == 3 else
+                np.stack([finalize_vectors(t, c, f, margin) for t, c, f in zip(tiles, covered, first.filled)]))
     twin = None
-    if all(r.twin is not None for _n, r in results):
-        twin = np.where(covered, sum(n * r.twin.astype(np.float64) for n, r in results) / total, 0.0).astype(np.float32)
+    if all(r.twin is not None for _n, r in rounds):
+        twin = mean(lambda r: r.twin).astype(np.float32)
+    total = sum(n for n, _r in rounds)
     error = None if twin is None else estimate(twin, covered, total)
-    stats = {**last.stats, "directions": total, "error": None if error is None else error.as_dict()}
-    return BakeResult(ao, covered, filled, stats, bent, last.tiles, twin, error)
+    stats = {**last.stats, **{k: first.stats[k] for k in ("covered_texels", "warnings") if k in first.stats},
+             "directions": total, "error": None if error is None else error.as_dict()}
+    return BakeResult(ao, covered, first.filled, stats, bent, first.tiles, twin, error)
+
+
+def _regrown(values: np.ndarray, covered: np.ndarray, first: BakeResult, margin: int) -> np.ndarray:
+    """values where covered, the margins grown from them as finalize_map grows a map's, the
+    first round's background elsewhere; elements (colour attributes) have no margins."""
+    if values.ndim == 1:
+        return np.where(covered, values, first.ao)
+    if values.ndim == 3:  # UDIM tiles
+        return np.stack([_regrown(v, c, replace(first, ao=a, filled=f), margin)
+                         for v, c, a, f in zip(values, covered, first.ao, first.filled)])
+    grown, _valid = dilate(values, covered, margin + 2)
+    return np.where(first.filled, grown, first.ao).astype(np.float32)
 
 
 def inverted(soup: TriangleSoup) -> TriangleSoup:

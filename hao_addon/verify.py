@@ -29,8 +29,8 @@ def verify_steps(target: BakeTarget, occluders: list[TriangleSoup], settings: Ba
         return None
     reference = replace(settings, method="reference", directions=VERIFY_DIRECTIONS, quality="fixed", max_error=0.0,
                         bent_normals=False, seed=(settings.seed + VERIFY_SEED) % 2**31)
-    plan = yield from make_plan_steps(target, occluders, reference)  # a projection's rays yield progress too
-    baker = ReferenceBaker(plan, cells)
+    plan = yield from make_plan_steps(target, occluders, reference, cells=cells)  # a projection's rays yield progress too
+    baker = ReferenceBaker(plan)
     try:
         sums_a, sums_b = yield from replicate_sums_steps(baker, VERIFY_DIRECTIONS)
     finally:

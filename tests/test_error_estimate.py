@@ -233,6 +233,11 @@ def test_every_target_bakes_to_a_stated_error(gpu_context, monkeypatch, target, 
     if target == "udim":
         assert res.tiles == (1001, 1002)
     assert len(casts) == (1 if target == "projected" else 0)
+    # After the pilot, converged texels are left out where the method can (counted), and the
+    # scatter says why it cannot.
+    assert st["skippable_fraction"] > 0.0, st["skippable_fraction"]
+    assert st["skipped_converged"] is (method != "scatter")
+    assert ("bakes_all_cells" in st) is (method == "scatter")
 
 
 def test_verification_intervals_cover_the_truth_at_their_rate():

@@ -151,7 +151,7 @@ GPU_TEXEL_LIST = True
 def cpu_receivers(plan: BakePlan) -> Receivers | None:
     """The receivers the gather uploads, or None where its GPU raster lists them."""
     if (plan.projected is None and plan.vertex_target is None and plan.udim is None and plan.settings.sample_count == 1
-            and GPU_TEXEL_LIST):
+            and plan.cells is None and GPU_TEXEL_LIST):
         return None
     return plan.receivers()
 

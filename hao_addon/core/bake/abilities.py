@@ -47,13 +47,17 @@ class BakerDeclaration:
     """method: the setting's value. label: its name in messages. gpu: runs on the GPU (Auto
     picks among these only). cannot: ability -> why not (in the words of a message, after
     'because'). auto_for: Auto prefers this baker when the bake needs all of these and the
-    baker can bake it (the benchmark's fastest at equal error); an empty set is the fallback."""
+    baker can bake it (the benchmark's fastest at equal error); an empty set is the fallback.
+    bakes_all_cells: why the baker bakes every texel of its target even when a plan names the
+    cells still needed (BakePlan.cells: the later rounds of a bake to an error); '' when it
+    bakes only those."""
 
     method: str
     label: str
     gpu: bool
     cannot: Mapping[str, str] = field(default_factory=dict)
     auto_for: frozenset[str] = frozenset()
+    bakes_all_cells: str = ""
 
     def can(self, ability: str) -> bool:
         return ability not in self.cannot
@@ -70,7 +74,8 @@ BAKERS = (
                                       "texels are no triangles it could draw",
                 "bent-normals": "its accumulator packs ambient occlusion's two sums in one word",
                 "udim": "it rasterizes one 0..1 UV tile",
-                "color-attribute": "it rasterizes the UV layout"}),
+                "color-attribute": "it rasterizes the UV layout"},
+        bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
     BakerDeclaration(
         "gather", "shadow-map gather", gpu=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "

@@ -95,18 +95,24 @@ class BakePlan:
     # Selected to Active: the projection's (receivers, stats, warning), which no direction or
     # seed changes: the rounds of a bake to an error pass it on (make_plan_steps' projection).
     projection: tuple | None = None
+    # The output cells (flat indices into output_shape) still to bake, or None for all: the
+    # later rounds of a bake to an error leave converged texels out, a verification bakes
+    # its sample. Receivers elsewhere are dropped (bakers that can: abilities.bakes_all_cells).
+    cells: np.ndarray | None = None
 
     def receivers(self) -> Receivers:
         """The bake's receivers: the projected high-poly points, the target's face corners
         (colour attributes), or the sample points of the target's own UV layout
         (samples_per_texel of them per texel)."""
         if self.projected is not None:
-            return self.projected
-        if self.vertex_target is not None:
-            return corner_receivers(self.target_faces, self.target_positions, self.target_corners,
-                                    self.vertex_target.cells, self.lifts_terminator)
-        return uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
-                            self.settings.size, self.settings.sample_count, self.lifts_terminator, self.udim)
+            receivers = self.projected
+        elif self.vertex_target is not None:
+            receivers = corner_receivers(self.target_faces, self.target_positions, self.target_corners,
+                                         self.vertex_target.cells, self.lifts_terminator)
+        else:
+            receivers = uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
+                                     self.settings.size, self.settings.sample_count, self.lifts_terminator, self.udim)
+        return receivers if self.cells is None else receivers.subset(np.isin(receivers.texel, self.cells))
 
     @property
     def output_shape(self) -> tuple[int, ...]:
@@ -253,12 +259,12 @@ def make_plan(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], 
 
 def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                     high_to_low: HighToLow | None = None, cast: RayCast | None = None,
-                    vertex_target: VertexTarget | None = None, projection: tuple | None = None
-                    ) -> Generator[float, None, BakePlan]:
+                    vertex_target: VertexTarget | None = None, projection: tuple | None = None,
+                    cells: np.ndarray | None = None) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled. projection:
     an earlier plan's (BakePlan.projection) of the same target, sources and settings but for
-    directions and seed, used instead of casting again."""
+    directions and seed, used instead of casting again. cells: BakePlan.cells."""
     settings = settings.validated()
     bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
     bake_target.check(settings.bent_normals)
@@ -392,7 +398,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, vertex_target, udim, stats, kind, alpha, projection)
+                    closed, holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells)
 
 
 def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:

@@ -42,6 +42,8 @@ class ReferenceBaker:
     @staticmethod
     def rays_needed(plan: BakePlan) -> int:
         """Rays of a whole bake at most (one per receiver and direction)."""
+        if plan.cells is not None:
+            return len(plan.cells) * plan.settings.sample_count * plan.settings.directions
         if plan.projected is not None:
             return len(plan.projected) * plan.settings.directions
         if plan.vertex_target is not None:
@@ -60,15 +62,10 @@ class ReferenceBaker:
                 f"(size^2 x samples per texel x directions), "
                 f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
 
-    def __init__(self, plan: BakePlan, cells: np.ndarray | None = None) -> None:
-        """cells: flat output indices (texels, tiles' texels or elements) to trace alone (a
-        verification's sample; core/bake/verify.py), or None for all."""
+    def __init__(self, plan: BakePlan) -> None:
         self.plan = plan
-        receivers = plan.receivers()
-        keep = receivers.inv_s > 0.0
-        if cells is not None:
-            keep &= np.isin(receivers.texel, cells)
-        receivers = receivers.subset(keep)
+        receivers = plan.receivers()  # plan.cells' alone where it names them
+        receivers = receivers.subset(receivers.inv_s > 0.0)
         self.texel = receivers.texel
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
         self.geometric = receivers.geometric
