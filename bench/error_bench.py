@@ -12,13 +12,17 @@ Meshes: the smooth rocker arm and smooth Spot at 256^2 in the layouts of Cycles'
   converged map (two gather seeds of CONVERGED directions, their noise taken out).
 - Cost: the bake at 256 directions with its two replicates summed apart against the same bake
   as one set (the estimate switched off), medians of interleaved runs.
-- To an error: --max-error at half an 8-bit step (p99 1/510) against fixed counts, each's
-  measured p99 against the converged map, and the smallest fixed count that reaches it.
+- To an error: --max-error at half an 8-bit step (p99 1/510) as shipped, and with its rounds
+  leaving converged texels out (SKIP_CONVERGED, off as shipped), against fixed counts; each's measured p99
+  against the converged map, and the smallest fixed count that reaches it. The converged map's
+  own noise is of the order of that target, so measured p99s are given raw and with the
+  truth's noise p99 taken out in quadrature (exact for normal errors).
 Writes error_bench.json and error_bench.png into the output folder.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import platform
 import statistics
@@ -56,8 +60,22 @@ def gather(soup, name, directions, seed=0, **kw):
 
 def measured(ao, truth, var, mask):
     e = ao[mask].astype(np.float64) - truth[mask]
-    return dict(rmse=float(np.sqrt(max((e * e).mean() - var[mask].mean(), 0.0))),
-                p99=float(np.percentile(np.abs(e), 99)))
+    p99 = float(np.percentile(np.abs(e), 99))
+    noise_p99 = float(np.percentile(np.sqrt(var[mask]), 99))  # |a - b| / 2: a draw of the truth's noise
+    return dict(rmse=float(np.sqrt(max((e * e).mean() - var[mask].mean(), 0.0))), p99=p99,
+                p99_noise_out=float(np.sqrt(max(p99 ** 2 - noise_p99 ** 2, 0.0))))
+
+
+class Skipping:
+    """Bakes to an error whose rounds after the first leave converged texels out (off as
+    shipped: hao_addon.bake.SKIP_CONVERGED)."""
+
+    def __enter__(self):
+        bake_module.SKIP_CONVERGED = True
+        return self
+
+    def __exit__(self, *exc):
+        bake_module.SKIP_CONVERGED = False
 
 
 class OneSet:
@@ -90,7 +108,7 @@ def main():
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     ensure_gpu_context()
-    converged_count = 4096 if args.quick else 16384
+    converged_count = 4096 if args.quick else 32768
     fixed_counts = [1024, 2048, 4096] if args.quick else [1024, 2048, 4096, 8192, 16384]
     results = dict(machine=platform.platform(), target_p99=TARGET, converged_directions=converged_count, meshes={})
     for name in MESHES:
@@ -114,20 +132,26 @@ def main():
             mask = inner & res.covered & high[0].covered
             row["fixed"].append(dict(directions=d, seconds=seconds, estimated=res.error.as_dict(),
                                      vs_converged=measured(res.ao, converged, converged_var, mask)))
-            print(f"{name} fixed {d:5d}: {seconds:6.2f} s, p99 measured {row['fixed'][-1]['vs_converged']['p99']:.5f} "
+            print(f"{name} fixed {d:5d}: {seconds:6.2f} s, p99 measured {row['fixed'][-1]['vs_converged']} "
                   f"estimated {res.error.p99:.5f}", flush=True)
-        seconds, res = gather(soup, name, fixed_counts[-1] * 2, max_error=TARGET)
-        mask = inner & res.covered & high[0].covered
-        row["to_error"] = dict(seconds=seconds, rounds=res.stats["rounds"], estimated=res.error.as_dict(),
-                               vs_converged=measured(res.ao, converged, converged_var, mask),
-                               skippable_fraction=res.stats["skippable_fraction"])
-        reaching = [f for f in row["fixed"] if f["vs_converged"]["p99"] <= TARGET]
+        for key, context in (("to_error", contextlib.nullcontext()), ("to_error_skipping", Skipping())):
+            with context:
+                seconds, res = gather(soup, name, fixed_counts[-1] * 2, max_error=TARGET)
+            mask = inner & res.covered & high[0].covered
+            row[key] = dict(seconds=seconds, rounds=res.stats["rounds"], estimated=res.error.as_dict(),
+                            vs_converged=measured(res.ao, converged, converged_var, mask),
+                            skipped_fraction=res.stats["skippable_fraction"])
+            print(f"{name} {key} p99 {TARGET:.5f}: {seconds:.2f} s, rounds {res.stats['rounds']}, measured "
+                  f"{row[key]['vs_converged']}, estimated {res.error.p99:.5f}, skipped "
+                  f"{res.stats['skippable_fraction']:.2f}", flush=True)
+        reaching = [f for f in row["fixed"] if f["vs_converged"]["p99_noise_out"] <= TARGET]
         row["smallest_fixed_reaching"] = reaching[0]["directions"] if reaching else None
         if reaching:
-            row["speedup_vs_smallest_fixed"] = reaching[0]["seconds"] / seconds
-        print(f"{name} to p99 {TARGET:.5f}: {seconds:.2f} s, rounds {res.stats['rounds']}, measured "
-              f"{row['to_error']['vs_converged']}, smallest fixed {row['smallest_fixed_reaching']}, skippable "
-              f"{res.stats['skippable_fraction']:.2f}", flush=True)
+            row["speedup_vs_smallest_fixed"] = reaching[0]["seconds"] / row["to_error"]["seconds"]
+        row["speedup_from_skipping"] = row["to_error"]["seconds"] / row["to_error_skipping"]["seconds"]
+        print(f"{name}: smallest fixed count reaching it {row['smallest_fixed_reaching']}, "
+              f"speed-up {row.get('speedup_vs_smallest_fixed')}, from skipping {row['speedup_from_skipping']:.2f}",
+              flush=True)
         results["meshes"][name] = row
     (out_dir / "error_bench.json").write_text(json.dumps(results, indent=1))
     plot(results, out_dir / "error_bench.png")
@@ -142,9 +166,11 @@ def plot(results, path):
         for key, style in (("calibration", "o"), ("fixed", "s")):
             t = [r["seconds"] for r in row[key]]
             ax.loglog(t, [r["estimated"]["p99"] for r in row[key]], style + "-", label=f"{key}: estimated p99")
-            ax.loglog(t, [r["vs_converged"]["p99"] for r in row[key]], style + "--", label=f"{key}: measured p99")
+            ax.loglog(t, [r["vs_converged"]["p99_noise_out"] for r in row[key]], style + "--",
+                      label=f"{key}: measured p99 (truth noise out)")
         te = row["to_error"]
-        ax.loglog([te["seconds"]], [te["vs_converged"]["p99"]], "r*", ms=14, label="--max-error 1/510: measured")
+        ax.loglog([te["seconds"]], [te["vs_converged"]["p99_noise_out"]], "r*", ms=14,
+                  label="--max-error 1/510: measured (truth noise out)")
         ax.loglog([te["seconds"]], [te["estimated"]["p99"]], "k+", ms=14, label="--max-error 1/510: estimated")
         ax.axhline(results["target_p99"], color="grey", lw=0.8)
         ax.set_title(name)

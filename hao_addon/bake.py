@@ -59,6 +59,16 @@ class BakeResult:
         return None if self.twin is None else local_rms(self.twin, self.covered)
 
 
+# Whether the rounds of a bake to an error after the first leave converged texels out
+# (core/bake/error_estimate.converged) where the method can. Off: measured on the smooth rocker
+# arm at half an 8-bit step (bench/error_bench.py), leaving out the 20 % of texel directions
+# that had converged saved 1 % of the time (the gather's time is mostly its depth maps, drawn
+# for every direction whatever the texels), and it made the estimate dishonest: 0.0019 p99
+# estimated, 0.0025 measured (0.0019 without). Texels chosen for small twins report those
+# twins; an honest choice needs a contrast the report does not use, a third replicate
+# (1.2-1.3x the map's noise at equal directions).
+SKIP_CONVERGED = False
+
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
 # the bunny pair at 1024^2: 2.8 s of 7.8 s at 256 directions, of 22 s at 1024).
 PROJECTION_PROGRESS_SHARE = 0.25
@@ -230,10 +240,10 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     """Rounds of whole bakes, each with its own direction set, until the estimated p99 of their
     union is within settings.error_target or settings.directions are spent (capped). Each
     round's size is predicted from the error so far (core/bake/error_estimate.next_round).
-    After the first, a round bakes only the texels that have not converged, where its method
-    can (abilities.bakes_all_cells); each texel is the mean of the rounds that baked it,
-    weighted by their directions, and so is its twin (independent rounds: still a draw of its
-    error)."""
+    Each texel is the mean of the rounds that baked it, weighted by their directions, and so is
+    its twin (independent rounds: still a draw of its error). Every round bakes every texel
+    (SKIP_CONVERGED); stats' skippable_fraction is the share of texel directions that
+    leaving converged texels out would have saved."""
     target_error, cap = settings.error_target, settings.directions
     rounds, history, shared = [], [], {}
     work = skipped = 0.0  # texel x direction pairs: all of them, and those left out
@@ -241,7 +251,7 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     while size > 0:
         round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
                                  seed=(settings.seed + 7919 * len(rounds)) % 2**31)
-        shared["cells"] = cells if skips else None
+        shared["cells"] = cells if skips and SKIP_CONVERGED else None
         steps = _bake_uncached(target, occluders, round_settings, shared)
         try:
             while True:
@@ -266,13 +276,13 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             active = combined.covered & ~converged(combined.twin, combined.covered, target_error)
             cells = np.flatnonzero(active) if active.any() else None
             work += size * float(combined.covered.sum())
-            skipped += 0.0 if cells is None else size * float(combined.covered.sum() - active.sum())
+            skipped += size * float(combined.covered.sum() - active.sum())
     capped = combined.error is not None and combined.error.p99 > target_error
     error = None if combined.error is None else replace(combined.error, capped=capped)
     method = rounds[0][1].stats["method"]
     stats = {**combined.stats, "error": None if error is None else error.as_dict(), "error_target": target_error,
              "rounds": [n for n, _r in rounds], "skippable_fraction": skipped / work if work else 0.0,
-             "skipped_converged": skips and skipped > 0.0,
+             "skipped_converged": SKIP_CONVERGED and skips and skipped > 0.0,
              **({"bakes_all_cells": declaration(method).bakes_all_cells} if not skips else {})}
     if capped:
         stats["warnings"] = [*stats.get("warnings", []),

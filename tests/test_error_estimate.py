@@ -73,11 +73,14 @@ def test_local_rms_is_the_neighbourhood_rms():
     assert ee.local_rms(twin, np.zeros_like(covered)).max() == 0.0
 
 
-def test_next_round_predicts_from_the_measured_rate():
-    # At the prior rate 0.75: p99 0.04 at 64 directions -> 0.01 needs 64 * 4^(4/3) = 406, plus 10 %.
+def test_next_round_predicts_along_the_rate_profile():
+    # Below 1024 directions at 0.75: p99 0.04 at 64 -> 0.01 needs 64 * 4^(4/3) = 406, plus 10 %.
     assert ee.next_round([(64, 0.04)], 0.01, 65536) == int(np.ceil(64 * 4 ** (1 / 0.75) * 1.1)) - 64
-    # Measured rate 0.5 (the p99 halved over 4x the directions): 0.01 -> 0.005 needs 4x again.
-    assert ee.next_round([(64, 0.02), (256, 0.01)], 0.005, 65536) == int(np.ceil(256 * 4 * 1.1)) - 256
+    # Past 1024 at 0.62: 0.01 at 1024 -> 0.005 needs 1024 * 2^(1 / 0.62).
+    assert ee.next_round([(1024, 0.01)], 0.005, 65536) == int(np.ceil(1024 * 2 ** (1 / 0.62) * 1.1)) - 1024
+    # Across: 0.087 at 64 (the rocker arm's pilot) falls to 0.0109 at 1024, then at 0.62.
+    reach = ee.directions_for(0.087, 64, 0.00196)
+    assert abs(reach - 1024 * (0.087 * 16 ** -0.75 / 0.00196) ** (1 / 0.62)) < 1e-6 * reach
     assert ee.next_round([(64, 0.009)], 0.01, 65536) == 0  # reached
     assert ee.next_round([(64, 0.04)], 0.01, 300) == 236   # the cap's remainder
     assert ee.next_round([(300, 0.04)], 0.01, 300) == 0    # capped
@@ -233,11 +236,35 @@ def test_every_target_bakes_to_a_stated_error(gpu_context, monkeypatch, target, 
     if target == "udim":
         assert res.tiles == (1001, 1002)
     assert len(casts) == (1 if target == "projected" else 0)
-    # After the pilot, converged texels are left out where the method can (counted), and the
-    # scatter says why it cannot.
+    # What leaving converged texels out would save is measured; nothing is left out
+    # (hao_addon.bake.SKIP_CONVERGED), and the scatter says why it could not.
     assert st["skippable_fraction"] > 0.0, st["skippable_fraction"]
-    assert st["skipped_converged"] is (method != "scatter")
+    assert st["skipped_converged"] is False
     assert ("bakes_all_cells" in st) is (method == "scatter")
+
+
+@pytest.mark.parametrize("method", ["gather", "reference"])
+def test_rounds_can_leave_converged_texels_out(gpu_context, monkeypatch, method):
+    """With SKIP_CONVERGED on (the benchmark's comparison), a round after the pilot bakes only
+    the texels not yet converged: fewer receivers traced or listed (counted)."""
+    import hao_addon.bake as bake_module
+    import hao_addon.core.bake.plan as plan_module
+    monkeypatch.setattr(bake_module, "SKIP_CONVERGED", True)
+    listed = []
+    original = plan_module.BakePlan.receivers
+
+    def counted(plan):
+        receivers = original(plan)
+        listed.append((plan.cells is not None, len(receivers)))
+        return receivers
+
+    monkeypatch.setattr(plan_module.BakePlan, "receivers", counted)
+    floor, ball = scenes.grid_plane(4.0, 8, name="floor"), scenes.uv_sphere(0.6, (0, 0, 0.6), 24, 12, name="ball")
+    res = bake(floor, [ball], BakeSettings(size=24, directions=4096, method=method, margin=0, max_error=0.03),
+               use_cache=False)
+    assert res.stats["skipped_converged"] is True and res.error.p99 <= 0.03
+    subsets = [n for subset, n in listed if subset]
+    assert subsets and max(subsets) < int(res.covered.sum()), (listed, int(res.covered.sum()))
 
 
 def test_verification_intervals_cover_the_truth_at_their_rate():

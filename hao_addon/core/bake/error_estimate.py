@@ -36,10 +36,12 @@ import numpy as np
 # The 99th percentile of |e| for a normal e is 2.576 sigma: a texel whose local RMS error times
 # this is below E has converged for a p99 bound of E.
 Z99 = 2.5758293035489
-# How the twins' p99 falls with directions, before two rounds have measured it: D^-0.75, the
-# rate of a Fibonacci set on visibility (measured 0.73 on the smooth rocker arm, 64 -> 256).
-RATE_PRIOR = 0.75
-RATE_RANGE = (0.5, 1.0)
+# How the twins' p99 falls with directions: (up to D, as D^-rate). Measured on the smooth rocker
+# arm and Spot (bench/error_bench.py, 64 to 16384 directions): 0.755 from 64 to 1024 on both,
+# then 0.70, 0.64, 0.60 on the rocker arm (0.70, 0.63, 0.61, 0.53 on Spot) per doubling: a
+# Fibonacci set's advantage over random directions shrinks as its cells get smaller than the
+# features they resolve. A prediction only: the bake stops on its measured estimate.
+RATE_PROFILE = ((1024.0, 0.75), (math.inf, 0.62))
 PILOT_DIRECTIONS = 64    # the first round of a bake to an error
 MIN_ROUND = 32           # no round smaller (a round is a whole bake: its set-up is paid again)
 OVERSHOOT = 1.1          # a round aims this much past the predicted count, to end in one more
@@ -118,24 +120,32 @@ def converged(twin: np.ndarray, covered: np.ndarray, max_error: float) -> np.nda
     a texel chosen for a small neighbourhood RMS may have drawn small twins by chance, and it
     gets no further round to show otherwise. Without the margin, Spot at 'draft' reported a
     p99 of 0.0098 where 0.012 was measured; choosing by the map's value instead (independent
-    of the twin) selects on the error itself (0.013 measured). With it, the texels left out
-    are far from the tail that decides the p99 (tests/test_error_estimate.py measures it)."""
+    of the twin) selects on the error itself (0.013 measured). Even with it the rocker arm at
+    half an 8-bit step reported 0.0019 where 0.0025 was measured, so bakes do not leave these
+    texels out (hao_addon.bake.SKIP_CONVERGED); they report the share they could."""
     return covered & (Z99 * CONVERGED_MARGIN * local_rms(twin, covered) <= max_error)
+
+
+def directions_for(p99: float, directions: float, max_error: float) -> float:
+    """The directions at which a p99 of `p99` at `directions` falls to max_error along
+    RATE_PROFILE (each stretch at its own rate)."""
+    for end, rate in RATE_PROFILE:
+        if directions >= end:
+            continue
+        reach = directions * (p99 / max_error) ** (1.0 / rate)
+        if reach <= end:
+            return reach
+        p99 *= (end / directions) ** -rate
+        directions = end
+    return directions
 
 
 def next_round(history: list[tuple[int, float]], max_error: float, cap: int) -> int:
     """Directions of the next round of a bake to a p99 of max_error, from (directions so far,
-    p99 then) after each round: the count the rate predicts (measured between the last two
-    rounds, RATE_PRIOR before), OVERSHOOT past it, at least MIN_ROUND, at most what the cap
-    leaves; 0 when done or capped."""
+    p99 then) after each round: the count RATE_PROFILE predicts from the last, OVERSHOOT past
+    it, at least MIN_ROUND, at most what the cap leaves; 0 when done or capped."""
     total, p99 = history[-1]
     if p99 <= max_error or total >= cap:
         return 0
-    rate = RATE_PRIOR
-    if len(history) >= 2:
-        (t0, p0), (t1, p1) = history[-2], history[-1]
-        if p0 > 0.0 and p1 > 0.0 and p1 < p0 and t1 > t0:
-            rate = math.log(p0 / p1) / math.log(t1 / t0)
-        rate = min(max(rate, RATE_RANGE[0]), RATE_RANGE[1])
-    needed = total * (p99 / max_error) ** (1.0 / rate) * OVERSHOOT
+    needed = directions_for(p99, total, max_error) * OVERSHOOT
     return int(min(cap - total, max(MIN_ROUND, math.ceil(needed) - total)))

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from ..setting_spec import Choice, SettingError, setting, validate
 from .tangent_space import CONVENTION_CHOICES, SPACE_CHOICES
+from .verify import VERIFY_DIRECTIONS
 
 GROUP_OCCLUDER_CHOICES = (
     Choice("group", "Group", "only the group's own meshes occlude its low-poly (an exploded bake without moving "
@@ -72,7 +73,7 @@ class JobOptions:
     verify: int = setting(
         0, label="Verify Texels", noun="verified texels", minimum=0, maximum=100000,
         description="after the bake, re-estimate this many random covered texels (seeded by Seed) with the CPU "
-                    "reference at 4096 directions, and report the map's RMSE, p99 and bias against it with 95 % "
+                    f"reference at {VERIFY_DIRECTIONS} directions, and report the map's RMSE, p99 and bias against it with 95 % "
                     "intervals (what the reference shares with the bake: the same surface points, normals and "
                     "estimator); 0 = off")
     verify_max_error: float = setting(
