@@ -11,6 +11,7 @@ from .cli_bake import fill_input_token, GLTF_OUT, has_token, image_outputs, run_
 from .cli_errors import CLIError, failure
 from .cli_io import Progress, REPORT, Report, Terminated
 from .cli_parser import BATCH_NAME
+from .core.folders import nearest_existing, unmakeable_reason
 from .core.output_files import check_output_files, INPUT_TOKEN, OBJECT_TOKEN
 
 
@@ -21,8 +22,9 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     if args.out_dir is None:
         raise CLIError("several inputs make a batch: give --out-dir DIR for their files")
     folder = Path(os.path.abspath(args.out_dir))
-    if not folder.is_dir() or not os.access(folder, os.W_OK):
-        raise CLIError(f"--out-dir '{args.out_dir}' does not exist or is not writable")
+    reason = unmakeable_reason(folder)
+    if reason or not os.access(nearest_existing(folder), os.W_OK):
+        raise CLIError(f"cannot make --out-dir '{args.out_dir}': {reason or 'permission denied'}")
     template = args.out or BATCH_NAME
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")

@@ -34,7 +34,7 @@ def add_setting_options(parser: argparse.ArgumentParser, settings_cls) -> None:
             parser.add_argument(option, dest=f.name, action="store_true", default=f.default, help=help_text)
         elif spec.choices:
             parser.add_argument(option, dest=f.name, choices=[c.value for c in spec.choices],
-                                default=cli_default(f, spec), help=help_text)
+                                type=type(f.default), default=cli_default(f, spec), help=help_text)
         else:
             parser.add_argument(option, dest=f.name, type=type(f.default), default=f.default,
                                 metavar=f.name.upper(), help=help_text)

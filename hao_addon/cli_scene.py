@@ -27,10 +27,13 @@ def check_input(path: Path, allowed: tuple[str, ...]) -> Path:
 def check_json_target(spec: str | None) -> None:
     if spec in (None, "-"):
         return
+    from .core.folders import nearest_existing, unmakeable_reason
+
     folder = Path(os.path.abspath(spec)).parent
-    if not folder.is_dir():
-        raise CLIError(f"cannot write the report '{spec}': folder does not exist")
-    if Path(spec).is_dir() or not os.access(folder, os.W_OK):
+    reason = unmakeable_reason(folder)
+    if reason:
+        raise CLIError(f"cannot write the report '{spec}': cannot make its folder, {reason}")
+    if Path(spec).is_dir() or not os.access(nearest_existing(folder), os.W_OK):
         raise CLIError(f"cannot write the report '{spec}'")
 
 
@@ -129,8 +132,11 @@ def check_mesh_target(path: str, source: Path, allowed: tuple[str, ...], option:
     out = Path(os.path.abspath(path))
     if out.suffix.lower() not in allowed:
         raise CLIError(f"{option} must be a {' or '.join(allowed)} file (one file, written atomically), got '{path}'")
-    if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
-        raise CLIError(f"cannot write '{out}': its folder does not exist or is not writable")
+    from .core.folders import nearest_existing, unmakeable_reason
+
+    reason = unmakeable_reason(out.parent)
+    if reason or not os.access(nearest_existing(out.parent), os.W_OK):
+        raise CLIError(f"cannot write '{out}': cannot make its folder, {reason or 'permission denied'}")
     if out.exists() and out.resolve() == source.resolve():
         raise CLIError(f"{option} '{out}' is the input file")
     return out
@@ -147,6 +153,7 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
     session as a .blend copy; atomically (a temporary file in the same folder, renamed over
     path)."""
     import bpy
+    from .core.folders import make_folders, remove_made
 
     for other in bpy.context.view_layer.objects:
         other.select_set(other in objects)
@@ -154,6 +161,7 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
     obj = objects[0]
     suffix = path.suffix.lower()
     tmp = path.with_name(f".{path.stem}.hao-{os.getpid()}{suffix}")
+    made = make_folders(path.parent)
     try:
         if suffix == ".glb":
             extra = {"export_vertex_color": 'ACTIVE'} if colors else {}
@@ -166,9 +174,11 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
         if result != {'FINISHED'} or not tmp.is_file():
             raise CLIError(f"writing '{obj.name}' to {path.name} failed")
         os.replace(tmp, path)
+        made = []
     finally:
         if tmp.exists():
             tmp.unlink()
+        remove_made(made)
 
 
 def export_glb(objects: list, path: Path) -> None:

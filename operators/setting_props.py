@@ -31,12 +31,13 @@ def tooltip(text: str) -> str:
 
 def enum_items(choices) -> tuple:
     """EnumProperty items of core Choice definitions."""
-    return tuple((c.value, c.label, tooltip(c.description)) for c in choices)
+    return tuple((str(c.value), c.label, tooltip(c.description)) for c in choices)
 
 
 def blender_property(field, spec, update=None):
     """The bpy.props definition of one setting."""
-    kw = {"name": spec.label, "description": spec.sentence, "default": field.default}
+    kw = {"name": spec.label, "description": spec.sentence,
+          "default": str(field.default) if spec.choices else field.default}
     if update is not None:
         kw["update"] = update
     if spec.choices:
@@ -69,4 +70,12 @@ def setting_annotations(settings_cls, update=None) -> dict:
 
 def settings_from(group: bpy.types.PropertyGroup, settings_cls):
     """The settings dataclass filled from a property group made by setting_annotations."""
-    return settings_cls(**{f.name: getattr(group, f.name) for f, spec in specs(settings_cls) if spec.ui})
+    return settings_cls(**{f.name: from_property(f, spec, getattr(group, f.name))
+                           for f, spec in specs(settings_cls) if spec.ui})
+
+
+def from_property(field, spec, value):
+    """A property's value as the setting holds it: an enum identifier back to its number."""
+    if spec.choices and isinstance(field.default, int):
+        return int(value)
+    return value

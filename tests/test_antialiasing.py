@@ -69,7 +69,7 @@ def side_fractions(surface: TriangleSoup, samples: int = 64) -> np.ndarray:
     return (side / np.maximum(np.bincount(texel, minlength=SIZE * SIZE), 1)).reshape(SIZE, SIZE)
 
 
-def bake_floor(method: str, samples: str):
+def bake_floor(method: str, samples: int):
     surface = roof()
     settings = BakeSettings(size=SIZE, directions=DIRECTIONS, method=method, margin=0, samples_per_texel=samples,
                             normals="face")
@@ -80,7 +80,7 @@ def bake_floor(method: str, samples: str):
 def truth(gpu_context):
     """(each texel's mean: the two sides' values (the reference's, away from the ridge)
     mixed by the texel's area on each side from 64 points, the edge texels)."""
-    surface, res = bake_floor("reference", "1")
+    surface, res = bake_floor("reference", 1)
     fraction = side_fractions(surface)
     edge = (fraction > 0.0) & (fraction < 1.0)
     gentle, steep = (float(np.median(res.ao[(fraction == v) & res.covered])) for v in (1.0, 0.0))
@@ -115,23 +115,23 @@ def test_sub_texel_points_are_a_stratified_grid():
 def test_sub_texel_samples_cut_the_edge_error(truth, method):
     """Along the ridge the centre sample errs by a good part of the jump; 16 samples per
     texel remove most of it (measured 0.069 -> 0.006; 4 samples 0.020)."""
-    _floor, one = bake_floor(method, "1")
-    _floor, many = bake_floor(method, "16")
+    _floor, one = bake_floor(method, 1)
+    _floor, many = bake_floor(method, 16)
     before, after = edge_rmse(one.ao, truth), edge_rmse(many.ao, truth)
     assert after < 0.25 * before, (before, after)
 
 
 def test_four_samples_already_halve_it(truth):
-    _floor, one = bake_floor("gather", "1")
-    _floor, four = bake_floor("gather", "4")
+    _floor, one = bake_floor("gather", 1)
+    _floor, four = bake_floor("gather", 4)
     assert edge_rmse(four.ao, truth) < 0.6 * edge_rmse(one.ao, truth)
 
 
 def test_the_scatter_takes_more_light_view_pixels_per_texel(truth):
     """The scatter averages each texel's area already; its anti-aliasing is a finer
     light-view grid (pixel side / sqrt(samples)): measured 0.024 -> 0.014 at 16."""
-    _floor, one = bake_floor("scatter", "1")
-    _floor, many = bake_floor("scatter", "16")
+    _floor, one = bake_floor("scatter", 1)
+    _floor, many = bake_floor("scatter", 16)
     assert many.stats["pixel_size_world"] == pytest.approx(one.stats["pixel_size_world"] / 4.0, rel=1e-6)
     assert edge_rmse(many.ao, truth) < 0.8 * edge_rmse(one.ao, truth)
 
@@ -141,9 +141,9 @@ def test_the_uploaded_texel_list_equals_the_gpu_raster(gpu_context, monkeypatch)
     GPU; the uploaded list (core/bake/receivers.py) holds the same receivers."""
     import hao_addon.gpu.bake_gather as gather
 
-    _floor, gpu_list = bake_floor("gather", "1")
+    _floor, gpu_list = bake_floor("gather", 1)
     monkeypatch.setattr(gather, "GPU_TEXEL_LIST", False)
-    _floor, uploaded = bake_floor("gather", "1")
+    _floor, uploaded = bake_floor("gather", 1)
     assert uploaded.stats["cpu_receivers"] is True and gpu_list.stats["cpu_receivers"] is False
     assert (uploaded.covered == gpu_list.covered).all()
     np.testing.assert_allclose(uploaded.ao, gpu_list.ao, atol=1e-6)

@@ -190,14 +190,15 @@ CASES = [
     ("output-extension", [BAKE, "{in}/spot.obj", "--out", "{out}/a.jpg"], 2, "unsupported output extension"),
     ("output-equals-input", [BAKE, "{in}/scene.blend", "--out", "{in}/scene.blend"], 2, "unsupported output extension"),
     ("output-is-input", [RENDER, "{in}/spot.obj.png", "--out", "{in}/spot.obj.png"], 2, "unsupported input"),
-    ("output-folder-missing", [BAKE, "{in}/spot.obj", "--out", "{out}/no/such/a.png"], 2, "folder does not exist"),
-    ("output-folder-is-file", [BAKE, "{in}/spot.obj", "--out", "{in}/spot.obj/a.png"], 2, "folder does not exist"),
+    ("output-folder-under-a-file", [BAKE, "{in}/spot.obj", "--out", "{in}/spot.obj/no/a.png"], 2,
+     "spot.obj' is a file, not a folder"),
+    ("output-folder-is-file", [BAKE, "{in}/spot.obj", "--out", "{in}/spot.obj/a.png"], 2, "is a file, not a folder"),
     ("output-unwritable", [BAKE, "{in}/spot.obj", "--out", "{locked}/a.png"], 2, "permission denied"),
     ("output-name-too-long", [BAKE, "{in}/spot.obj", "--out", "{out}/" + "n" * 260 + ".png"], 2,
      "longer than the file system"),
     ("output-is-folder", [BAKE, "{in}/spot.obj", "--out", "{in}/blend1"], 2, "unsupported output extension"),
     ("output-is-folder-png", [BAKE, "{in}/spot.obj", "--out", "{in}/dir.png"], 2, "it is a folder"),
-    ("report-folder-missing", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{out}/no/r.json"], 2,
+    ("report-folder-missing", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--json", "{in}/spot.obj/r.json"], 2,
      "cannot write the report"),
     ("texture-set-one-object", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--texture-set"], 2,
      "--texture-set bakes several meshes"),
@@ -266,8 +267,8 @@ CASES = [
      "no mesh with an Armature modifier"),
     ("render-frame-not-a-number", [RENDER, "{in}/scene.blend", "--out", "{out}/a.png", "--frame", "x"], 2,
      "invalid int value"),
-    ("render-output-folder-missing", [RENDER, "{in}/scene.blend", "--out", "{out}/no/a.png"], 2,
-     "folder does not exist"),
+    ("render-output-folder-under-a-file", [RENDER, "{in}/scene.blend", "--out", "{in}/spot.obj/no/a.png"], 2,
+     "is a file, not a folder"),
     ("render-output-extension", [RENDER, "{in}/scene.blend", "--out", "{out}/a.tif"], 2,
      "unsupported output extension"),
     ("render-everything-beyond-far-clip", [RENDER, "{in}/farclip.blend", "--out", "{out}/a.png", "--width", "32",
@@ -323,7 +324,8 @@ CASES = [
      2, "would write every input's map to the same file"),
     ("batch-out-is-a-path", [BAKE, "{in}/spot.obj", "--out-dir", "{out}", "--out", "sub/{input}.png"], 2,
      "is a file name in it, not a path"),
-    ("batch-out-dir-missing", [BAKE, "{in}/spot.obj", "--out-dir", "{out}/missing"], 2, "does not exist"),
+    ("batch-out-dir-under-a-file", [BAKE, "{in}/spot.obj", "--out-dir", "{in}/spot.obj/missing"], 2,
+     "is a file, not a folder"),
     ("batch-without-out-dir", [BAKE, "{in}/spot.obj", "{in}/a/x.obj", "--out", "{out}/a.png"], 2,
      "give --out-dir DIR"),
     ("batch-one-gltf-for-all", [BAKE, "{in}/spot.obj", "{in}/a/x.obj", "--out-dir", "{out}", "--gltf-out",
@@ -337,8 +339,8 @@ CASES = [
      "a step of at least 1"),
     ("frames-negative-backwards", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "-1--5"], 2,
      "the range must run forwards"),
-    ("frames-names-the-first-frame", [BAKE, "{in}/spot.obj", "--out", "{out}/no/{frame}.png", "--frames", "5-6"], 2,
-     "no/0005.png': folder does not exist"),
+    ("frames-names-the-first-frame", [BAKE, "{in}/spot.obj", "--out", "{in}/spot.obj/{frame}.png", "--frames", "5-6"], 2,
+     "spot.obj/0005.png': cannot make its folder"),
     ("frames-into-a-color-attribute", [BAKE, "{in}/spot.obj", "--out", "{out}/a.glb", "--target", "color-attribute",
                                        "--frames", "1-2"], 2, "a colour attribute holds one frame"),
     # Selected to Active
@@ -552,7 +554,7 @@ def test_bake_operator_bad_input(scene, tmp_path, case):
 RENDER_OPERATOR_CASES = [
     ("resolution-beyond-limits", "texture limit"),
     ("relative-path-unsaved", "relative to the .blend file"),
-    ("missing-folder", "folder does not exist"),
+    ("folder-under-a-file", "is a file, not a folder"),
     ("no-mesh", "no visible mesh objects"),
 ]
 
@@ -571,13 +573,14 @@ def test_render_operator_bad_input(scene, tmp_path, setup, message):
         r.resolution_x = 65536
     elif setup == "relative-path-unsaved":
         path = "//hao.png"
-    elif setup == "missing-folder":
-        path = str(tmp_path / "no" / "hao.png")
-    before = scene_state()
+    elif setup == "folder-under-a-file":
+        (tmp_path / "file").write_bytes(b"")
+        path = str(tmp_path / "file" / "no" / "hao.png")
+    before, files_before = scene_state(), sorted(tmp_path.rglob("*"))
     try:
         with pytest.raises(RuntimeError, match=message):
             bpy.ops.render.hao_render_ao(filepath=path)
     finally:
         r.resolution_x, r.resolution_y, r.resolution_percentage = saved
     assert scene_state() == before
-    assert list(tmp_path.iterdir()) == []
+    assert sorted(tmp_path.rglob("*")) == files_before

@@ -97,6 +97,22 @@ def test_batch_needs_a_folder_and_distinct_names(inputs, tmp_path):
     assert os.listdir(out) == []
 
 
+def test_missing_output_folders_are_made_when_the_files_are_written(inputs, tmp_path):
+    """--out, --out-dir and --json make the folders they name (as Blender's -o does); an
+    input that fails makes none."""
+    folder, _out = inputs
+    done = run([folder / "a.obj", "--out", tmp_path / "new" / "deeper" / "a.png", "--size", "64",
+                "--directions", "8", "--json", tmp_path / "reports" / "r.json"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "new" / "deeper" / "a.png").is_file() and (tmp_path / "reports" / "r.json").is_file()
+    done = run([folder / "a.obj", folder / "b.obj", "--out-dir", tmp_path / "batch" / "x", "--size", "64",
+                "--directions", "8"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert sorted(os.listdir(tmp_path / "batch" / "x")) == ["a_ao.png", "b_ao.png"]
+    done = run([folder / "broken.obj", "--out", tmp_path / "never" / "a.png"], tmp_path)
+    assert done.returncode == 2 and not (tmp_path / "never").exists(), done.stderr
+
+
 def test_all_meshes_bakes_each_mesh_of_an_input(tmp_path):
     """--all-meshes: every mesh gets its own file (_{object} added to the default name)."""
     from test_cli_runs import write_obj

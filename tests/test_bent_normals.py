@@ -179,7 +179,7 @@ def test_bent_normals_in_every_gather_variant_match_the_reference(gpu_context, v
     if variant == "max_distance":
         kw.update(max_distance=1.0, falloff="wendland")
     elif variant == "anti_aliasing":
-        kw.update(samples_per_texel="4")
+        kw.update(samples_per_texel=4)
     else:  # a plane above the floor projects onto it, its texels 0.3 to 2.3 from the wall
         # (nearer ones are within two light-view pixels of it, where the gather's depth test
         # cannot resolve contact: bake_helpers' max_floor)

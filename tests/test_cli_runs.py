@@ -110,17 +110,18 @@ def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
 
 
 def test_output_checks_come_before_any_work(dirs):
-    """A legal 254-byte name bakes (the temporary name is short); a missing folder fails
-    before the scene is loaded or the GPU is touched."""
+    """A legal 254-byte name bakes (the temporary name is short); a folder that cannot be
+    made fails before the scene is loaded or the GPU is touched."""
     out, tmp = dirs
     name = "a" * 250 + ".png"
     proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / name, "--quiet"], tmp)
     assert proc.returncode == 0 and (out / name).is_file(), proc.stderr
     report = out / "r.json"
     for command in (["bake", SPOT, "--size", "64"], ["render-ao", ROOT / "tests" / "data" / "CesiumMan.glb"]):
-        proc = run([*command, "--out", out / "missing" / "x.png", "--json", report], tmp)
+        (out / "file").write_bytes(b"")
+        proc = run([*command, "--out", out / "file" / "x.png", "--json", report], tmp)
         data = json.loads(report.read_text())
-        assert proc.returncode == 2 and "folder does not exist" in proc.stderr
+        assert proc.returncode == 2 and "is a file, not a folder" in proc.stderr
         assert set(data["timings"]) == {"total"}, data["timings"]
 
 

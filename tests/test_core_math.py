@@ -168,7 +168,7 @@ def test_settings_validation_messages():
     with pytest.raises(ValueError, match="directions"):
         BakeSettings(directions=0).validated()
     with pytest.raises(ValueError, match="samples per texel must be one of 1, 4, 9, 16"):
-        BakeSettings(samples_per_texel="5").validated()
+        BakeSettings(samples_per_texel=5).validated()
     with pytest.raises(ValueError, match="max distance"):
         BakeSettings(max_distance=float("nan")).validated()
 

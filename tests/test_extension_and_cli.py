@@ -116,7 +116,7 @@ os._exit(0)  # bpy 4.2 segfaults at interpreter exit after a glTF export (exit -
 @pytest.mark.parametrize("args, message", [
     (["missing.obj", "--out", "x.png"], "input file not found"),
     (["samples/spot.obj", "--out", "x.jpg"], "unsupported output extension"),
-    (["samples/spot.obj", "--out", "no/such/dir/x.png"], "folder does not exist"),
+    (["samples/spot.obj", "--out", "samples/spot.obj/dir/x.png"], "is a file, not a folder"),
     (["samples/spot.obj", "--out", "x.png", "--size", "0"], "map size"),
     (["samples/spot.obj", "--out", "x.png", "--uv-map", "Nope"], "no UV map named 'Nope'"),
     (["samples/spot.obj", "--out", "x.png", "--object", "Nope"], "no mesh object named 'Nope'"),

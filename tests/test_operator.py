@@ -107,8 +107,9 @@ def test_saved_file_matches_image_and_orientation(scene, tmp_path, ext):
 
 def test_unwritable_output_fails_before_anything_changes(scene, tmp_path):
     obj = monkey()
-    small_settings(scene, filepath=str(tmp_path / "missing" / "ao.png"))
-    with pytest.raises(RuntimeError, match="folder does not exist"):
+    (tmp_path / "file").write_bytes(b"")
+    small_settings(scene, filepath=str(tmp_path / "file" / "missing" / "ao.png"))
+    with pytest.raises(RuntimeError, match="is a file, not a folder"):
         bpy.ops.object.hao_bake_ao()
     small_settings(scene, filepath=str(tmp_path / "ao.jpg"))
     with pytest.raises(RuntimeError, match="unsupported output extension"):

@@ -12,7 +12,8 @@ import pytest
 from hao_addon.core.bake.projection import EXTRUSION_RESOLUTION, FLOAT32_SPACING, HighToLow, max_extrusion
 from hao_addon.core.bake.uv_checks import uv_layout_warnings
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.imageio import StagedFiles, byte_size
+from hao_addon.core.folders import unmakeable_reason
+from hao_addon.core.imageio import StagedFiles, atomic_write_bytes, byte_size
 from hao_addon.core.output_files import OutputCollision, check_output_files
 
 
@@ -63,10 +64,39 @@ def test_a_failed_write_leaves_nothing(tmp_path):
     staged.write_bytes(tmp_path / "a.png", b"a")
     with pytest.raises(ValueError, match="NaN"):
         staged.write_image(tmp_path / "b.png", np.full((4, 4), np.nan))
+    (tmp_path / "file").write_bytes(b"")
     with pytest.raises(OSError):
-        staged.write_bytes(tmp_path / "missing" / "c.png", b"c")
+        staged.write_bytes(tmp_path / "file" / "c.png", b"c")
+    staged.write_bytes(tmp_path / "made" / "deeper" / "d.png", b"d")  # its folders are made...
+    assert (tmp_path / "made" / "deeper").is_dir()
     staged.discard()
+    assert os.listdir(tmp_path) == ["file"]  # ...and removed with the staged files
+
+
+def test_missing_folders_are_made_for_the_files_and_kept_with_them(tmp_path):
+    staged = StagedFiles()
+    staged.write_bytes(tmp_path / "a" / "b" / "x.png", b"x")
+    staged.commit()
+    staged.rollback()  # the folders go with the file they were made for
     assert os.listdir(tmp_path) == []
+    staged = StagedFiles()
+    staged.write_bytes(tmp_path / "a" / "b" / "x.png", b"x")
+    staged.commit()
+    staged.release()
+    assert (tmp_path / "a" / "b" / "x.png").read_bytes() == b"x"
+    atomic_write_bytes(tmp_path / "c" / "r.json", b"{}")
+    assert (tmp_path / "c" / "r.json").read_bytes() == b"{}"
+
+
+@pytest.mark.parametrize("where, reason", [("a/b", None), ("f/b", "'{tmp}/f' is a file, not a folder"),
+                                           ("locked/b", "permission denied in '{tmp}/locked'")])
+def test_only_a_folder_that_cannot_be_made_is_refused(tmp_path, where, reason):
+    (tmp_path / "f").write_bytes(b"")
+    (tmp_path / "locked").mkdir(mode=0o500)
+    if reason and "permission" in reason and os.access(tmp_path / "locked", os.W_OK):
+        pytest.skip("running as root: every folder is writable")
+    assert unmakeable_reason(tmp_path / where) == (reason and reason.format(tmp=tmp_path))
+    assert not (tmp_path / where).exists()  # checked, not made
 
 
 @pytest.mark.parametrize("count, text", [(0, "0 bytes"), (1023, "1023 bytes"), (1024, "1.0 KiB"),

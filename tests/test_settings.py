@@ -53,8 +53,8 @@ def test_panel_properties_match_the_core(addon, cls, command, group):
         prop = rna[f.name]
         assert prop.name == spec.label and prop.description.lower().startswith(spec.description[:20].lower())
         if spec.choices:
-            assert [i.identifier for i in prop.enum_items] == [c.value for c in spec.choices]
-            assert prop.default == f.default
+            assert [i.identifier for i in prop.enum_items] == [str(c.value) for c in spec.choices]
+            assert prop.default == str(f.default)
             continue
         if isinstance(f.default, bool):
             assert prop.default == f.default
@@ -95,6 +95,26 @@ def test_core_validation_is_the_spec(cls):
             with pytest.raises(SettingError, match=spec.message_name) as err:
                 cls(**{f.name: value}).validated()
             assert err.value.name == f.name
+
+
+@pytest.mark.parametrize("cls", [s[0] for s in SETTINGS], ids=[s[0].__name__ for s in SETTINGS])
+def test_a_choice_is_of_its_settings_kind(cls):
+    """Reports and --json carry a setting as the core holds it: a mode as a word, a count as a
+    number, never a count as a string ("1")."""
+    for f, spec in specs(cls):
+        assert all(type(c.value) is type(f.default) for c in spec.choices), f.name
+        if spec.choices and isinstance(f.default, str):
+            assert not any(c.value.isdigit() for c in spec.choices), f.name
+
+
+def test_panel_values_reach_the_settings_as_their_kind(addon, scene):
+    """A count chosen in the panel (an enum whose identifiers are strings) reaches the bake
+    as a number."""
+    scene.hao_bake.samples_per_texel = "4"
+    try:
+        assert scene.hao_bake.to_settings().samples_per_texel == 4
+    finally:
+        scene.hao_bake.samples_per_texel = "1"
 
 
 def test_every_setting_is_described_once():

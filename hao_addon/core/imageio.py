@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import BakeInputError
+from .folders import make_folders, nearest_existing, remove_made, unmakeable_reason
 
 FORMATS = {".png": "PNG", ".exr": "OPEN_EXR"}
 TEMP_PREFIX = ".hao-"
@@ -41,16 +42,18 @@ def file_bytes_estimate(path: str | Path, width: int, height: int, channels: int
 
 def check_writable(path: str | Path, width: int, height: int, channels: int, source: str | Path | None = None) -> Path:
     """Refuse, before any work, an output that could not be written: unsupported extension, the
-    input file itself, a missing or read-only folder, a name too long for the file system,
-    an existing folder or read-only file of that name, or too little free space. Returns the
-    absolute path. (The write itself is atomic: a temporary file renamed into place.)"""
+    input file itself, a folder that cannot be made (a missing one is made when the file is
+    written), a read-only folder, a name too long for the file system, an existing folder or
+    read-only file of that name, or too little free space. Returns the absolute path. (The
+    write itself is atomic: a temporary file renamed into place.)"""
     path = Path(os.path.abspath(path))
     format_for_path(path)
     if source is not None and path == Path(os.path.abspath(source)):
         raise BakeInputError(f"the output '{path}' is the input file: choose another name")
-    folder = path.parent
-    if not folder.is_dir():
-        raise BakeInputError(f"cannot write '{path}': folder does not exist")
+    reason = unmakeable_reason(path.parent)
+    if reason:
+        raise BakeInputError(f"cannot write '{path}': cannot make its folder, {reason}")
+    folder = nearest_existing(path.parent)  # where the file, or its first missing folder, goes
     try:
         name_max = os.pathconf(folder, "PC_NAME_MAX")
     except (OSError, ValueError, AttributeError):  # no pathconf (Windows): NTFS allows 255
@@ -98,8 +101,7 @@ def _can_create_in(folder: Path) -> bool:
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write data to path through a temporary file in the same folder, renamed into place."""
     path = Path(path)
-    if not path.parent.is_dir():
-        raise OSError(f"output folder does not exist: {path.parent}")
+    made = make_folders(path.parent)
     # A short temporary name: the target's own name can already be at the length limit.
     fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
     try:
@@ -111,6 +113,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        remove_made(made)
         raise
 
 
@@ -125,6 +128,7 @@ class StagedFiles:
     def __init__(self) -> None:
         self._staged: list[tuple[Path, str]] = []  # (target, temporary file)
         self._placed: list[tuple[Path, str | None]] = []  # (target, backup of the file it replaced)
+        self._made: list[Path] = []  # folders made for the files, removed again by discard()
 
     @property
     def paths(self) -> list[str]:
@@ -133,8 +137,7 @@ class StagedFiles:
 
     def write_bytes(self, path: str | Path, data: bytes) -> None:
         path = Path(path)
-        if not path.parent.is_dir():
-            raise OSError(f"output folder does not exist: {path.parent}")
+        self._made += make_folders(path.parent)
         fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
         self._staged.append((path, tmp))  # first: removed by discard() even if the write fails
         with os.fdopen(fd, "wb") as fh:
@@ -170,6 +173,7 @@ class StagedFiles:
             if backup is not None and os.path.lexists(backup):
                 os.unlink(backup)
         self._placed.clear()
+        self._made.clear()  # they hold the new files now
 
     def rollback(self) -> None:
         """Put back what commit replaced, remove what it added, and discard what is staged."""
@@ -186,6 +190,9 @@ class StagedFiles:
             if os.path.lexists(tmp):
                 os.unlink(tmp)
         self._staged.clear()
+        if not self._placed:  # nothing of ours is left in them
+            remove_made(self._made)
+            self._made.clear()
 
 
 def _umask() -> int:

@@ -16,7 +16,10 @@ from .errors import BakeInputError
 
 @dataclass(frozen=True)
 class Choice:
-    value: str
+    """One allowed value: a word (a mode) or a number (a count). Reports and the command
+    line use the value as it is; a Blender enum, whose identifiers are strings, its str()."""
+
+    value: str | int
     label: str
     description: str
 
@@ -62,7 +65,7 @@ class Spec:
     def range_text(self) -> str:
         """'16 to 16384 texels', '> 0', 'none, wendland' ..."""
         if self.choices:
-            return ", ".join(c.value for c in self.choices)
+            return ", ".join(str(c.value) for c in self.choices)
         unit = f" {self.unit}" if self.unit else ""
         low, high = self.minimum, self.maximum
         if low is not None and high is not None:

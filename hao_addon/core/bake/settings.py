@@ -66,10 +66,10 @@ QUALITY_CHOICES = (
 # The p99 error each Quality bakes to (0: none, Directions decide).
 QUALITY_ERRORS = {"fixed": 0.0, "draft": 0.01, "8-bit": 0.5 / 255.0, "16-bit": 0.125 / 255.0, "custom": None}
 SAMPLES_PER_TEXEL_CHOICES = (
-    Choice("1", "Off", "one sample at each texel centre"),
-    Choice("4", "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
-    Choice("9", "9 Samples", "a 3 x 3 grid of points in each texel, averaged"),
-    Choice("16", "16 Samples", "a 4 x 4 grid of points in each texel, averaged"),
+    Choice(1, "Off", "one sample at each texel centre"),
+    Choice(4, "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
+    Choice(9, "9 Samples", "a 3 x 3 grid of points in each texel, averaged"),
+    Choice(16, "16 Samples", "a 4 x 4 grid of points in each texel, averaged"),
 )
 
 
@@ -115,8 +115,8 @@ class BakeSettings:
     margin: int = setting(
         16, label="Margin", minimum=0, maximum=1024, unit="texels", subtype='PIXEL',
         description="texels grown past every UV island, so filtering never reads the background")
-    samples_per_texel: str = setting(
-        "1", label="Anti-Aliasing", noun="samples per texel", choices=SAMPLES_PER_TEXEL_CHOICES,
+    samples_per_texel: int = setting(
+        1, label="Anti-Aliasing", noun="samples per texel", choices=SAMPLES_PER_TEXEL_CHOICES,
         description="stratified points per texel, averaged, for silhouettes, thin features and UV edges "
                     "(the scatter, which averages each texel's area already, takes that many times more "
                     "light-view pixels per texel)")
@@ -206,8 +206,8 @@ class BakeSettings:
 
     @property
     def sample_count(self) -> int:
-        """Samples per texel as a number (1, 4, 9 or 16)."""
-        return int(self.samples_per_texel)
+        """Samples per texel (1, 4, 9 or 16)."""
+        return self.samples_per_texel
 
     def cache_key(self) -> tuple:
         return tuple(sorted(asdict(self).items()))
