@@ -295,7 +295,7 @@ def main() -> int:
     for name in args.meshes.split(",") if "flat" in parts else []:
         print(f"{name}:", flush=True)
         t = time.perf_counter()
-        soup = obj_soup(MESHES[name], uvs="xatlas", size=size)
+        soup = obj_soup(MESHES[name], uvs="auto", size=size)
         unwrap_s = time.perf_counter() - t
         ys, xs, ref, ref_s, interior = reference_points(soup, size, ref_texels, ref_rays)
         print(f"  reference: {len(ref)} texels x {ref_rays} rays in {ref_s:.1f} s", flush=True)
@@ -310,7 +310,7 @@ def main() -> int:
         (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
     for name in args.meshes.split(",") if "smooth" in parts else []:
         print(f"{name}, shaded smooth:", flush=True)
-        soup = obj_soup(MESHES[name], uvs="xatlas", size=size)
+        soup = obj_soup(MESHES[name], uvs="auto", size=size)
         results.setdefault("smooth", {})[name] = smooth_rows(soup, size, dirs, spp[:-1] or spp, truth_spp)
         (out / "bake_bench.json").write_text(json.dumps(results, indent=1))
     if "high-to-low" in parts:

@@ -57,7 +57,7 @@ def load(name):
     from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
     from hao_addon.core.geometry import TriangleSoup, smooth_vertex_normals
     from hao_addon.core.objfile import obj_soup
-    soup = obj_soup(BUNNY, uvs="xatlas", size=cases.TRUTH_SIZE)
+    soup = obj_soup(BUNNY, uvs="auto", size=cases.TRUTH_SIZE)
     soup = TriangleSoup(soup.positions, soup.uvs, "bunny", smooth_vertex_normals(soup.positions))
     face, _b, hits = texel_surface_samples(soup.uvs, cases.TRUTH_SIZE)
     return soup, None, None, interior_mask(face, hits)

@@ -82,7 +82,7 @@ def vertex_normals(positions: np.ndarray) -> np.ndarray:
 def write_inputs(path: Path) -> None:
     sys.path.insert(0, str(ROOT))
     from hao_addon.core.objfile import obj_soup, read_obj
-    rocker_soup = obj_soup(ROOT / "tests" / "data" / "rocker-arm.obj", uvs="xatlas", size=512)
+    rocker_soup = obj_soup(ROOT / "tests" / "data" / "rocker-arm.obj", uvs="auto", size=512)
     rocker = rocker_soup.positions
     pair = np.load(ROOT / "tests" / "data" / "cycles_bunny_high_to_low.npz")
     low = pair["low_vertices"][pair["low_triangles"]]

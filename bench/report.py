@@ -104,13 +104,20 @@ def spheres_tables(res: dict) -> str:
 
 def main() -> int:
     path = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parent / "results" / "bake_bench.json")
-    res = json.loads(path.read_text())
-    if "frame" in res or "distances" in res:
-        print(hao_tables(res))
-        return 0
+    print(tables(json.loads(path.read_text())))
+    return 0
+
+
+def tables(res: dict) -> str:
+    """Markdown tables of a bake, HAO or spheres benchmark's results."""
     if "sync_numpy" in res:
-        print(spheres_tables(res))
-        return 0
+        return spheres_tables(res)
+    if "frame" in res or "distances" in res:
+        return hao_tables(res)
+    return bake_tables(res)
+
+
+def bake_tables(res: dict) -> str:
     lines = []
     for name, m in res.get("meshes", {}).items():
         lines.append(f"**{name}** ({m['triangles']:,} triangles, {m['size']}x{m['size']}; xatlas "
@@ -166,8 +173,7 @@ def main() -> int:
             lines.append(f"| {r['triangles']:,} | {r['ms_per_direction']:.1f} |")
         lines.append("")
     lines.append(f"Machine: {res['machine']['platform']}; Blender {res['machine']['blender']}; {res['machine']['gpu']}.")
-    print("\n".join(lines))
-    return 0
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -193,7 +193,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
 void main()
 {
   /* This dispatch covers entries first_entry .. entry_end - 1 (a run of normal bins that can
-   * face one of its views, core/normal_bins.py), LIST_WIDTH per grid row. */
+   * face one of its views, core/bake/normal_bins.py), LIST_WIDTH per grid row. */
   int index = first_entry + int(gl_GlobalInvocationID.y) * LIST_WIDTH + int(gl_GlobalInvocationID.x);
   if (index >= entry_end) {
     return;

@@ -61,7 +61,7 @@ void main()
    * occluded (Cycles' AO pass traces only directions above the geometric normal). Averted
    * faces are not drawn; the denominator here sums the directions above the face, whose
    * weights total above_fraction of S, so the numerator carries that fraction: the ratio is
-   * the whole estimator (core/plan.py, _shading_corners). */
+   * the whole estimator (core/bake/plan.py, _shading_corners). */
   float weight_den = weight / max(above_fraction, 1e-6);
 #else
   float weight_den = weight;

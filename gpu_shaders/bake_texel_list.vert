@@ -2,7 +2,7 @@
  * per covered texel centre, carrying the surface point and its normals.
  * pos: normalized world position; uv: UV in [0, 1]; face: the corner's shading normal and
  * 1 / S (the face normal and 1 / S_f on flat faces); geometric: the face normal;
- * bin: the face's normal bin (core/normal_bins.py), a small whole number. With the terminator
+ * bin: the face's normal bin (core/bake/normal_bins.py), a small whole number. With the terminator
  * offset each corner also carries its whole face (corners and their shading normals) and its
  * barycentric unit vector, so the fragment computes Cycles' lift of its point. */
 void main()

@@ -1,5 +1,5 @@
-/* Shared by the Hybrid Ambient Occlusion passes; mirrored in hao_addon/core/ao_pattern.py
- * and hao_addon/core/bilateral.py, which the tests compare against. HAO_GOLDEN_FRACTION and
+/* Shared by the Hybrid Ambient Occlusion passes; mirrored in hao_addon/core/hao/ao_pattern.py
+ * and hao_addon/core/hao/bilateral.py, which the tests compare against. HAO_GOLDEN_FRACTION and
  * HAO_SELF_OFFSET are defines from ao_pattern.GLSL_DEFINES (one value for both sides). */
 
 /* Wendland C2 kernel, HAO paper equation 3: w(t, h) = (1 - t/h)^4 (4 t/h + 1) on [0, h]. */

@@ -1,7 +1,7 @@
 /* Surface pass: mark the voxel of this column that holds the triangle's point (imageAtomicOr
  * into a bit-packed grid, bits along z, at y offset grid_dims.w: the cascade's place in the
  * texture). Solid pass: flip every voxel of the column whose
- * centre lies below the triangle (parity; see hao_addon/core/voxel_grid.py). */
+ * centre lies below the triangle (parity; see hao_addon/core/hao/voxel_grid.py). */
 void main()
 {
   voxel_out = vec4(0.0); /* llvmpipe runs fragment side effects only with a colour write */

@@ -4,7 +4,7 @@
  * sphere pushed back along -n and summed with equations 2 and 3.
  *
  * Two choices make the sum an estimate of the form factor rather than an arbitrary sum (the
- * numpy mirror is hao_addon/core/near_field.py, which documents them): a sample only counts
+ * numpy mirror is hao_addon/core/proxies/near_field.py, which documents them): a sample only counts
  * when its patch faces the receiver (a ray through a closed occluder enters once through a
  * facing patch, so the two layers do not count it twice), and its sphere's cross-section
  * equals the patch's area seen from the receiver; M random samples of the disk stand for all

@@ -16,7 +16,7 @@ void main()
   if (dist > sphere_reach) {
     discard;
   }
-  /* Inside the sphere the distance is clamped to r (see hao_addon/core/sphere_ao.py). */
+  /* Inside the sphere the distance is clamped to r (see hao_addon/core/proxies/sphere_ao.py). */
   float r = sphere_data.w;
   float occlusion = 1.0;
   if (dist > 0.0) {

@@ -16,6 +16,7 @@ from typing import Callable, Generator
 
 import numpy as np
 
+from .core.steps import drain, relay
 from .core.blas_threads import single_threaded_blas
 from .core.geometry import TriangleSoup, bounding_sphere
 from .core.errors import BakeInputError
@@ -172,16 +173,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     shared = {} if shared is None else shared
     planning = make_plan_steps(target, occluders, settings, cast=cast, projection=shared.get("projection"),
                                cells=shared.get("cells"))
-    try:
-        while True:
-            try:
-                fraction = next(planning)
-            except StopIteration as stop:
-                plan = stop.value
-                break
-            yield share * fraction
-    finally:
-        planning.close()  # cancelled during the projection: stop it there
+    plan = yield from relay(planning, lambda fraction: share * fraction)  # a cancel stops the projection
     shared["projection"] = plan.projection
     method = choose_method(settings.method, plan.abilities_needed)
     baker_cls = baker_for(method)
@@ -252,18 +244,11 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
                                  seed=(settings.seed + 7919 * len(rounds)) % 2**31)
         shared["cells"] = cells if skips and SKIP_CONVERGED else None
-        steps = _bake_uncached(target, occluders, round_settings, shared)
-        try:
-            while True:
-                try:
-                    fraction = next(steps)
-                except StopIteration as stop:
-                    part = stop.value
-                    break
-                shown = max(shown, min(0.99, (done + fraction * size) / max(done + size, 1)))
-                yield shown
-        finally:
-            steps.close()
+        def overall(fraction: float, done: int = done, size: int = size) -> float:
+            nonlocal shown  # progress never goes back when a round is added
+            shown = max(shown, min(0.99, (done + fraction * size) / max(done + size, 1)))
+            return shown
+        part = yield from relay(_bake_uncached(target, occluders, round_settings, shared), overall)
         skips = not declaration(part.stats["method"]).bakes_all_cells
         rounds.append((size, part))
         done += size
@@ -369,17 +354,8 @@ def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], setti
          progress: Callable[[float], None] | None = None, use_cache: bool = True,
          high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> BakeResult:
     """Blocking bake (drains bake_steps)."""
-    steps = bake_steps(target, occluders, settings, use_cache, high_to_low, vertex_target)
-    try:
-        while True:
-            try:
-                fraction = next(steps)
-            except StopIteration as stop:
-                return stop.value
-            if progress is not None:
-                progress(fraction)
-    finally:
-        steps.close()  # if progress() raised: free the GPU pass now, not at garbage collection
+    # (drain closes it if progress() raises: the GPU pass is freed now, not at garbage collection.)
+    return drain(bake_steps(target, occluders, settings, use_cache, high_to_low, vertex_target), progress)
 
 
 __all__ = ["BakeInputError", "BakeResult", "BakeTarget", "HighToLow", "VertexTarget", "bake", "bake_key", "bake_steps",

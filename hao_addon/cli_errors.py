@@ -6,7 +6,7 @@ import os
 import traceback
 
 from .cli_io import EXIT_INTERRUPTED, pending_signal, ProcessOutput, Terminated
-from .core.errors import BakeInputError
+from .core.errors import UserInputError
 
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
@@ -46,7 +46,7 @@ def failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
         GPUUnavailableError = ()  # noqa: N806
     if GPUUnavailableError and isinstance(exc, GPUUnavailableError):
         return EXIT_NO_GPU, last_line(exc)
-    if isinstance(exc, (BakeInputError, OSError)):  # UnwrapError and SettingError included
+    if isinstance(exc, (UserInputError, OSError)):  # bake and view input, UnwrapError, SettingError
         return EXIT_BAD_INPUT, last_line(exc)
     if os.environ.get(DEBUG_ENV) and io is not None:
         io.err.write(io.log() + "".join(traceback.format_exception(exc)))

@@ -95,7 +95,7 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--all-meshes", action="store_true",
                    help="bake every mesh of each input (each into its own file), not only the largest")
     add_setting_options(b, BakeSettings)
-    b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else xatlas)")
+    b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else an automatic unwrap)")
     b.add_argument("--object", action="append", default=None, metavar="NAME",
                    help="mesh to bake (default: the mesh with the most faces); repeatable: each into its own "
                         "file ({object} in --out, else _NAME is added), or with --texture-set all into one")

@@ -8,7 +8,7 @@ import numpy as np
 
 from .blender.sphere_proxies import scene_spheres
 from .blender.view_scene import camera_view_projection, visible_scene_objects
-from .core.errors import BakeInputError
+from .core.errors import ViewInputError
 from .core.hao.methods import method_plan
 from .core.hao.view_settings import RenderSize, ViewAOSettings, render_gpu_bytes
 
@@ -24,7 +24,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     from .gpu.util import check_render_limits, texture_to_numpy
 
     if camera is None or camera.type != 'CAMERA':
-        raise BakeInputError("no camera: pass --camera NAME or give the scene a camera")
+        raise ViewInputError("no camera: pass --camera NAME or give the scene a camera")
     settings = settings.validated()
     RenderSize(width, height).validated()
     ensure_gpu_context()
@@ -33,7 +33,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     view_layer = bpy.context.view_layer
     objects = visible_scene_objects(depsgraph, view_layer, skip_baked=skip_baked)
     if not objects:
-        raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects")
+        raise ViewInputError(f"scene '{scene.name}' has no visible mesh objects")
     spheres = scene_spheres(view_layer, depsgraph)[0] if method_plan(settings.method).spheres else None
     view_proj = camera_view_projection(camera, depsgraph, width, height)
     own = renderer is None
@@ -46,7 +46,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
         if own:
             renderer.free()
     if not coverage.any():  # an empty picture is no AO: said as plainly as no mesh at all
-        raise BakeInputError(f"scene '{scene.name}' has no visible mesh objects in the view of '{camera.name}': "
+        raise ViewInputError(f"scene '{scene.name}' has no visible mesh objects in the view of '{camera.name}': "
                              f"every mesh lies outside its frame or its clip range ({camera.data.clip_start:g} "
                              f"to {camera.data.clip_end:g})")
     rgba = np.empty((height, width, 4), np.float32)

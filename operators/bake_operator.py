@@ -9,12 +9,12 @@ import bpy
 
 from ..hao_addon.blender.bake_job import BakeJob
 from ..hao_addon.blender.color_attributes import AO_ATTRIBUTE
-from ..hao_addon.core.errors import BakeInputError
+from ..hao_addon.core.errors import UserInputError
 from ..hao_addon.blender.gpu_context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
 
 # Errors a user can act on: reported, never raised into Blender's console.
-USER_ERRORS = (BakeInputError, GPUUnavailableError, ShaderCompileError, ValueError, OSError, KeyError, RuntimeError)
+USER_ERRORS = (UserInputError, GPUUnavailableError, ShaderCompileError, ValueError, OSError, KeyError, RuntimeError)
 # Wall time of GPU work per modal tick: short enough to keep the UI responsive.
 TICK_BUDGET_S = 0.1
 

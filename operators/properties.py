@@ -20,7 +20,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
     # and outputs the Blender job uses.
     uv_mode: EnumProperty(
         name="UV Map", description="Which UV map the AO is baked into",
-        items=(('AUTO', "Auto", "AO_UV if present, else the first UV map, else a new AO_UV map unwrapped with xatlas"),
+        items=(('AUTO', "Auto", "AO_UV if present, else the first UV map, else a new AO_UV map unwrapped automatically (planar charts packed by xatlas)"),
                ('ACTIVE', "Active Render", "The UV map marked active for rendering"),
                ('NAMED', "Named", "The UV map named below")),
         default='AUTO')

@@ -31,7 +31,7 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
     def execute(self, context):
         from ..hao_addon.blender.paths import absolute_path
         from ..hao_addon.blender.view_scene import region_box
-        from ..hao_addon.core.errors import BakeInputError
+        from ..hao_addon.core.errors import UserInputError
         from ..hao_addon.core.imageio import check_writable, write_ao_file
         from ..hao_addon.blender.gpu_context import GPUUnavailableError
         from ..hao_addon.render_ao import render_camera_ao
@@ -48,7 +48,7 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
                                     region=region_box(props), skip_baked=props.skip_baked)
             if path is not None:
                 write_ao_file(path, rgba)
-        except (BakeInputError, GPUUnavailableError, OSError) as exc:
+        except (UserInputError, GPUUnavailableError, OSError) as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
         image = bpy.data.images.get(IMAGE_NAME)

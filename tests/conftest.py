@@ -1,6 +1,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Shared fixtures. Tests run headless through the bpy wheel on whatever OpenGL the machine
-has (llvmpipe in CI). GPU tests do not skip when the context fails: CI must see it."""
+has (llvmpipe in CI). GPU tests do not skip when the context fails: CI must see it.
+
+The numpy tier (NUMPY_TIER: the core floor's tests) needs no bpy: in an environment without
+the wheel (numpy, xatlas and pytest only) `pytest tests` runs those files alone, and
+tests/test_numpy_tier.py shows that they pass with bpy, gpu and mathutils unimportable."""
 from __future__ import annotations
 
 import importlib.util
@@ -16,9 +20,13 @@ DATA = Path(__file__).resolve().parent / "data"
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402  (bpy must be importable for every test module)
+try:
+    import bpy  # noqa: E402
+except ImportError:  # the numpy tier alone
+    bpy = None
 
-from hao_addon import compat  # noqa: E402
+# Test files of the numpy floor (hao_addon/core): they import no bpy, gpu or mathutils.
+NUMPY_TIER = ("test_core_math.py", "test_output_files.py", "test_spheres.py", "test_unwrap.py", "test_numpy_tier.py")
 
 _EXIT_STATUS = 0
 
@@ -33,8 +41,15 @@ def pytest_configure(config):
                                        "oldest release (run on the newest)")
 
 
+def pytest_ignore_collect(collection_path, config):
+    """Without bpy, everything but the numpy tier."""
+    if bpy is None and collection_path.suffix == ".py" and collection_path.name not in NUMPY_TIER:
+        return True
+    return None
+
+
 def pytest_collection_modifyitems(config, items):
-    if tuple(bpy.app.version[:2]) != OLDEST_RELEASE:
+    if bpy is None or tuple(bpy.app.version[:2]) != OLDEST_RELEASE:
         return
     skip = pytest.mark.skip(reason="release-independent CPU test: run on the newest release (CI time)")
     for item in items:
@@ -49,7 +64,8 @@ def pytest_sessionfinish(session, exitstatus):
 
 def pytest_unconfigure(config):
     """After the summary is printed: skip bpy 4.2's crashing module teardown (see compat)."""
-    if compat.module_exit_may_crash():
+    from hao_addon import compat
+    if bpy is not None and compat.module_exit_may_crash():
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(_EXIT_STATUS)

@@ -56,8 +56,8 @@ def corner_uvs(name: str, size: int = TRUTH_SIZE) -> np.ndarray:
         return uv[tu]
     if truth_path(name).exists():
         return np.load(truth_path(name))["uvs"].astype(np.float64)
-    from hao_addon.core.bake.unwrap import xatlas_unwrap
-    return xatlas_unwrap(v, t, size)
+    from hao_addon.core.bake.unwrap import unwrap_in_process
+    return unwrap_in_process(v, t, size)
 
 
 def custom_vertex_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -121,7 +121,7 @@ def _smooth_object(name: str, vertices: np.ndarray, triangles: np.ndarray, uvs: 
 def decimated_low_poly(name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertices (V, 3), triangles (F, 3), corner UVs (F, 3, 2)) of the case's low-poly: the
     high-poly through Blender's Decimate (collapse) at the case's ratio, unwrapped by xatlas."""
-    from hao_addon.core.bake.unwrap import xatlas_unwrap
+    from hao_addon.core.bake.unwrap import unwrap_in_process
     path, ratio, _e, _d = HIGH_TO_LOW[name]
     v, t, _uv, _tu = read_obj(path)
     obj = _smooth_object("decimate", v, t)
@@ -132,7 +132,7 @@ def decimated_low_poly(name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     lv = np.array([x.co[:] for x in mesh.vertices], np.float64)
     lt = np.array([tri.vertices[:] for tri in mesh.loop_triangles], np.int64)
     bpy.data.objects.remove(obj)
-    return lv, lt, xatlas_unwrap(lv, lt, TRUTH_SIZE)
+    return lv, lt, unwrap_in_process(lv, lt, TRUTH_SIZE)
 
 
 def build_high_to_low(name: str, low: tuple[np.ndarray, np.ndarray, np.ndarray]):

@@ -20,7 +20,7 @@ SIZE, DIRS, REF_RAYS, TEXELS = 512, 128, 256, 400
 
 @pytest.fixture(scope="module")
 def rocker():
-    soup = obj_soup(DATA / "rocker-arm.obj", uvs="xatlas", size=SIZE)
+    soup = obj_soup(DATA / "rocker-arm.obj", uvs="auto", size=SIZE)
     assert soup.face_count == 20088
     face, bary, hits = texel_surface_samples(soup.uvs, SIZE)
     inner = interior_mask(face, hits)

@@ -89,7 +89,7 @@ def test_gather_matches_the_reference_on_the_rocker_arm(gpu_context):
     from pathlib import Path
 
     size = 128
-    soup = obj_soup(Path(__file__).parent / "data" / "rocker-arm.obj", uvs="xatlas", size=size)
+    soup = obj_soup(Path(__file__).parent / "data" / "rocker-arm.obj", uvs="auto", size=size)
     kw = dict(size=size, directions=256, margin=0, bent_normals=True)
     gather = bake(soup, [], BakeSettings(method="gather", **kw), use_cache=False)
     ref = bake(soup, [], BakeSettings(method="reference", **kw), use_cache=False)

@@ -13,12 +13,13 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import ROOT
 
 SPOT = ROOT / "samples" / "spot.obj"
-BUNNY = ROOT / "bench" / "data" / "stanford-bunny.obj"  # no UVs: xatlas takes ~20 s on it
+BUNNY = ROOT / "bench" / "data" / "stanford-bunny.obj"
 
 
 def env_for(tmp: Path) -> dict:
@@ -70,7 +71,9 @@ def test_object_token_and_json_report(dirs):
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
-                                    smooth_corners=0, error=data["objects"][0]["error"])]  # no 's' groups: flat
+                                    smooth_corners=data["objects"][0]["smooth_corners"],
+                                    error=data["objects"][0]["error"])]
+    assert data["objects"][0]["smooth_corners"] >= 0.99 * 3 * 5856  # 's 1': the sample is shaded smooth
     assert data["objects"][0]["error"]["directions"] == 8 and not data["objects"][0]["error"]["capped"]
     assert data["settings"]["size"] == 64 and data["settings"]["view_samples"] == 2.0
     # An OBJ carries no terminator offset of its own: --terminator-offset (default 0.1) applies.
@@ -89,10 +92,9 @@ def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
     """An OBJ's 's' groups and 'vn' normals, and a glTF's normals, reach the bake through
     Blender's importers (the evaluated mesh's corner normals); --normals face bakes flat anyway."""
     out, tmp = dirs
-    smooth = tmp.parent / "spot_smooth.obj"
-    lines = SPOT.read_text().splitlines(keepends=True)
-    first_face = next(i for i, line in enumerate(lines) if line.startswith("f "))
-    smooth.write_text("".join(lines[:first_face] + ["s 1\n"] + lines[first_face:]))
+    smooth = SPOT  # the sample has 's 1' before its faces
+    flat = tmp.parent / "spot_flat.obj"
+    flat.write_text("".join(line for line in SPOT.read_text().splitlines(keepends=True) if not line.startswith("s ")))
     suzanne = ROOT / "tests" / "data" / "suzanne.obj"  # one 'vn' per vertex, no UVs: xatlas unwraps it
 
     def corners(path, *extra):
@@ -105,6 +107,7 @@ def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
     total = 3 * 5856
     assert corners(smooth) > 0.9 * total  # smooth: nearly every corner leans off its face
     assert corners(smooth, "--normals", "face") == 0
+    assert corners(flat) == 0  # no 's' groups, no normals: Blender's importer shades it flat
     assert corners(suzanne) > 0
     assert corners(ROOT / "tests" / "data" / "CesiumMan.glb") > 0
 
@@ -211,17 +214,38 @@ def test_progress_on_a_terminal_and_not_when_quiet(dirs):
 
 @pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
                                                 (signal.SIGTERM, 143, "terminated")])
+def big_sphere_obj(path: Path, segments: int = 640, rings: int = 320) -> Path:
+    """An indexed UV sphere without UVs (409,600 triangles at the defaults): an unwrap of
+    seconds, long enough to be interrupted in (the bunny's takes under one)."""
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, rings + 1)[1:-1], np.linspace(0.0, 2 * np.pi, segments,
+                                                                                     endpoint=False), indexing="ij")
+    ring = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1).reshape(-1, 3)
+    vertices = np.concatenate([[[0.0, 0.0, 1.0]], ring, [[0.0, 0.0, -1.0]]])
+    index = 1 + np.arange(len(ring)).reshape(rings - 1, segments)  # 0-based rows of the ring vertices
+    right = np.roll(index, -1, axis=1)
+    quads_a = np.stack([index[:-1], index[1:], right[1:]], -1).reshape(-1, 3)
+    quads_b = np.stack([index[:-1], right[1:], right[:-1]], -1).reshape(-1, 3)
+    top = np.stack([np.zeros(segments, int), index[0], right[0]], -1)
+    bottom = np.stack([np.full(segments, len(vertices) - 1), right[-1], index[-1]], -1)
+    faces = np.concatenate([top, quads_a, quads_b, bottom]) + 1
+    with open(path, "w") as fh:
+        fh.write("".join(f"v {x:.7g} {y:.7g} {z:.7g}\n" for x, y, z in vertices))
+        fh.write("".join(f"f {a} {b} {c}\n" for a, b, c in faces))
+    return path
+
+
 def test_signal_during_unwrap_stops_at_once(dirs, signum, code, word):
     out, tmp = dirs
-    proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", BUNNY, "--size", "512", "--directions", "8",
+    sphere = big_sphere_obj(tmp.parent / "big_sphere.obj")
+    proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", sphere, "--size", "512", "--directions", "8",
                              "--out", out / "a.png"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             env=env_for(tmp), cwd=tmp, text=True)
     end = time.monotonic() + 60
     while not children_of(proc.pid) and time.monotonic() < end and proc.poll() is None:
         time.sleep(0.05)
     workers = children_of(proc.pid)
-    assert workers, "the xatlas child never started"
-    time.sleep(0.5)  # well inside the unwrap (about 20 s for the bunny)
+    assert workers, "the unwrap's child never started"
+    time.sleep(0.5)  # well inside the unwrap (seconds for the big sphere)
     t0 = time.monotonic()
     proc.send_signal(signum)
     stdout, stderr = proc.communicate(timeout=30)

@@ -295,7 +295,7 @@ def test_verify_agrees_with_the_estimate_and_sees_what_it_cannot(gpu_context, me
     The scatter averages each texel's area, a systematic difference from the centre's value
     (its bias against Cycles, -0.004 to -0.006) that no direction count removes: its own
     estimate misses it, the verification sees at least twice the estimate."""
-    from hao_addon.core.bake.plan import drain
+    from hao_addon.core.steps import drain
     from hao_addon.core.bake.targets import BakeTarget
     from hao_addon.verify import verify_steps
     name = "spot_smooth"

@@ -42,6 +42,16 @@ def test_zip_contains_the_extension_and_no_dev_files(built_zip):
     assert not any(n.startswith(("tests/", "bench/", "docs/", ".venv/", ".ci/")) for n in names)
 
 
+def test_the_extension_carries_its_manual_and_no_made_up_website(built_zip):
+    """There is no public site: the manifest names none, and the zip holds the built manual
+    that the add-on's preferences open (operators/preferences.py)."""
+    import tomllib
+    names = set(zipfile.ZipFile(built_zip).namelist())
+    assert {"site/index.html", "site/baking-in-blender.html", "site/benchmarks.html"} <= names
+    manifest = tomllib.loads(zipfile.ZipFile(built_zip).read("blender_manifest.toml").decode())
+    assert "website" not in manifest
+
+
 def test_installed_zip_bakes(built_zip, tmp_path):
     out = tmp_path / "ao.png"
     proc = run([str(ROOT / "tests" / "scripts" / "install_and_bake.py"), str(built_zip), str(out)],

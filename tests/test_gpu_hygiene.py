@@ -25,35 +25,31 @@ def test_missing_shader_file_is_named():
 
 
 def test_every_shader_variant_compiles(gpu_context):
-    from hao_addon.gpu import bake_gather, bake_scatter
-    from hao_addon.gpu import light_view
-    light_view.depth_shader()
-    light_view.layers_shader()
-    for uniform in (False, True):
-        for layered in (False, True):
-            for wendland in (False, True):
-                for footprint in (False, True):
-                    bake_scatter.splat_shader(uniform, layered, wendland, footprint)
-        for falloff in (None, "none", "wendland"):
-            for shading in (False, True):
-                bake_gather.gather_shader(uniform, 1, shading, falloff)
-        bake_gather.gather_shader(uniform, 4)
-        bake_gather.texel_list_shader(fill=uniform)
-    from hao_addon.gpu import hao_composite, hao_gbuffer, hao_sampling, hao_voxelize
-    from hao_addon.gpu.shaders import cached_shader
-    hao_addon_shaders = [hao_gbuffer.gbuffer_shader(), hao_voxelize.voxelize_shader(True),
-                         hao_voxelize.voxelize_shader(False), cached_shader(("hao_pyramid",), hao_voxelize._pyramid_info)]
-    for march in ("hierarchical", "fixed"):
-        for falloff in ("none", "wendland"):
-            hao_addon_shaders.append(hao_sampling.ao_shader(march, falloff))
-    for axis in (0, 1):
-        hao_addon_shaders.append(hao_sampling.bilateral_shader(axis, axis == 0))
-    cached_shader(("hao_composite",), hao_composite._composite_info)
-    from hao_addon.gpu import near_field, sphere_far
-    sphere_far.far_shader()
-    near_field.near_shader()
-    hao_gbuffer.gbuffer_shader(back_layer=True)
-    # Every file in gpu_shaders/ is used by some pass (no dead shader text ships).
+    """Every variant of every shader factory the passes declare (shaders.shader_variants)
+    compiles; every shader the package compiles comes from a declared factory; every file in
+    gpu_shaders/ is used by some pass (no dead shader text ships)."""
+    import importlib
+    import inspect
+    import pkgutil
+    import hao_addon.gpu as gpu_package
+    for info in pkgutil.iter_modules(gpu_package.__path__):
+        importlib.import_module(f"hao_addon.gpu.{info.name}")  # each module registers its factories
+    for factory, domains in shaders.SHADER_FACTORIES:
+        variants = shaders.variant_arguments(factory, domains)
+        assert variants, f"{factory.__name__} declares no valid variant"
+        for arguments in variants:
+            assert factory(**arguments) is not None, (factory.__name__, arguments)
+    # A shader compiled outside a declared factory would escape this test.
+    declared = {factory.__qualname__ for factory, _ in shaders.SHADER_FACTORIES}
+    for info in pkgutil.iter_modules(gpu_package.__path__):
+        module = importlib.import_module(f"hao_addon.gpu.{info.name}")
+        for name, function in inspect.getmembers(module, inspect.isfunction):
+            if function.__module__ == module.__name__ and "cached_shader(" in inspect.getsource(function) \
+                    and name != "cached_shader":
+                assert function.__qualname__ in declared, f"{module.__name__}.{name} compiles an undeclared shader"
+        for _cls_name, cls in inspect.getmembers(module, inspect.isclass):
+            if cls.__module__ == module.__name__:
+                assert "cached_shader(" not in inspect.getsource(cls), f"{cls.__name__} compiles a shader inline"
     sources = "".join(p.read_text() for p in (shaders.SHADER_DIR.parent / "hao_addon").rglob("*.py"))
     for path in shaders.SHADER_DIR.iterdir():
         assert f'"{path.name}"' in sources, f"{path.name} is not loaded by any pass"
@@ -83,6 +79,24 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
     assert [len(h) for h in handler_lists] == counts
 
 
+def test_uniform_structs_are_generated_from_their_dtypes():
+    """A block's GLSL struct is its numpy dtype's (one layout, written once); a dtype that
+    std140 would pad differently is refused rather than generated wrong."""
+    import numpy as np
+    from hao_addon.gpu.bake_gather import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE
+    from hao_addon.gpu.hao_sampling import CASCADES_DTYPE
+    from hao_addon.gpu.shaders import SHADER_DIR, glsl_struct
+    assert glsl_struct("GatherViews", GATHER_VIEWS_DTYPE).splitlines()[1:3] == [
+        f"  mat4 view_proj[{GATHER_MAX_VIEWS}];", f"  vec4 plane_slope[{GATHER_MAX_VIEWS}];"]
+    assert glsl_struct("HaoCascades", CASCADES_DTYPE).splitlines()[-2:] == ["  ivec4 count;", "};"]
+    assert not any("struct GatherViews" in p.read_text() or "struct HaoCascades" in p.read_text()
+                   for p in SHADER_DIR.iterdir())
+    for bad in (np.dtype([("a", "<f4", (3,))]), np.dtype([("a", "<f8", (4,))]),
+                np.dtype([("a", "<f4", (4,)), ("b", "<i4", (2, 3))])):
+        with pytest.raises(TypeError, match="std140"):
+            glsl_struct("Bad", bad)
+
+
 def test_constants_reach_glsl_from_python_only():
     """Each constant the GPU and its numpy mirror share is written once, in Python."""
     from hao_addon.core.hao.ao_pattern import GLSL_DEFINES
@@ -93,9 +107,20 @@ def test_constants_reach_glsl_from_python_only():
         # The value itself only where it is distinctive (1.0 is written everywhere).
         distinctive = len(repr(value)) > 4
         assert not any(f"#define {name}" in s or (distinctive and repr(value) in s) for s in sources.values()), name
-    assert "[4]" not in sources["bake_gather_views.glsl"] and "GATHER_MAX_VIEWS" in sources["bake_gather_views.glsl"]
     # std140 size of GatherViews: one array of GATHER_MAX_VIEWS mat4 (64 B) and three of vec4 (16 B).
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
     assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16 + 16)
     assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "plane_slope", "omega", "view_info")] == \
         [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80, GATHER_MAX_VIEWS * 96]
+
+
+def test_shader_comments_cite_files_that_exist():
+    """A file a shader's comment points to (a Python twin, another shader) exists under the
+    name given: from the repository, the package, its gpu/ folder or gpu_shaders/."""
+    import re
+    from hao_addon.gpu import shaders
+    root = shaders.SHADER_DIR.parent
+    bases = (root, root / "hao_addon", root / "hao_addon" / "gpu", shaders.SHADER_DIR)
+    for path in shaders.SHADER_DIR.iterdir():
+        for cited in re.findall(r"[A-Za-z_./]+\.(?:py|glsl|comp|frag|vert)\b", path.read_text()):
+            assert any((base / cited).is_file() for base in bases), f"{path.name} cites '{cited}', which does not exist"

@@ -12,18 +12,31 @@ from test_hao import view
 from test_spheres_gpu import CENTRES, RADII, _scene
 
 def test_every_method_is_a_plan_of_known_passes_in_dependency_order():
-    from hao_addon.gpu.hao_renderer import AO_MAP, FRAME_INPUTS, PASSES, HaoRenderer
+    from hao_addon.gpu.hao_renderer import AO_MAP, FRAME_INPUTS, PASSES
     assert set(METHOD_PLANS) == set(METHODS)
     for plan in METHOD_PLANS.values():
         written = set(FRAME_INPUTS)
         for name in plan.passes:
             spec = PASSES[name]
-            assert hasattr(HaoRenderer, "_run_" + name), name
+            assert callable(spec.run) and spec.run.__qualname__.startswith("HaoRenderer."), name
             missing = set(spec.reads) - written
             assert not missing, f"{plan.name}: {name} reads {missing} before anything wrote it"
             written.add(spec.writes or name)
         assert plan.passes[-1] == "filter" and AO_MAP in written
         assert plan.spheres == ("spheres" in plan.passes)
+
+
+def test_the_viewport_refuses_its_input_as_view_input_not_bake_input(renderer):
+    """What the viewport cannot render is a ViewInputError (a UserInputError every interface
+    reports as one line), not a bake's error."""
+    from hao_addon.core.errors import BakeInputError, UserInputError, ViewInputError
+    objs, _ = _scene()
+    vp, _w, _h = view((2.2, -2.6, 2.4), target=(0.0, 0.0, 0.2))
+    with pytest.raises(ViewInputError, match="image size must be positive") as refused:
+        renderer.render(objs, vp, 0, 16, ViewAOSettings(rays=8, grid=64))
+    assert isinstance(refused.value, UserInputError) and not isinstance(refused.value, BakeInputError)
+    with pytest.raises(ViewInputError, match="needs sphere proxies"):
+        renderer.render(objs, vp, 16, 16, ViewAOSettings(rays=8, grid=64, method="far"))
 
 
 @pytest.mark.parametrize("other", ["near", "far"])

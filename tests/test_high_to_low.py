@@ -20,7 +20,8 @@ from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.geometry import TriangleSoup
-from hao_addon.core.bake.projection import barycentric, drain, ray_starts
+from hao_addon.core.bake.projection import barycentric, ray_starts
+from hao_addon.core.steps import drain
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
 from hao_addon.gpu.util import live_pass_count

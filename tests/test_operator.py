@@ -176,12 +176,25 @@ def test_modal_runner_completes_and_commits(scene):
     from hao_ext.operators.bake_operator import ModalBakeRunner
     from hao_addon.blender.bake_job import BakeJob
 
+    from hao_addon.bake import clear_cache
     obj = monkey()
-    job = BakeJob(small_settings(scene).to_request([obj]), bpy.context.evaluated_depsgraph_get)
+    settings = small_settings(scene)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}  # the blocking bake, for comparison
+    image = bpy.data.images[f"{obj.name}_AO"]
+    blocking = np.array(image.pixels[:], np.float32)
+    bpy.data.images.remove(image)
+    clear_cache()  # the modal bake bakes again, not from the cache
+    job = BakeJob(settings.to_request([obj]), bpy.context.evaluated_depsgraph_get)
     runner = ModalBakeRunner(job)
-    while not runner.tick(budget_s=0.05):
-        pass
-    assert f"{obj.name}_AO" in bpy.data.images
+    fractions = []
+    while not runner.tick(budget_s=0.01):
+        fractions.append(runner.fraction)
+    # It ran in steps (the UI stays live between them), its progress never went back...
+    assert len(fractions) >= 2 and all(b >= a for a, b in zip(fractions, fractions[1:])), fractions
+    # ...and it committed what the blocking bake makes: the same map, bit for bit.
+    modal = np.array(bpy.data.images[f"{obj.name}_AO"].pixels[:], np.float32)
+    assert modal.min() < 0.9  # the monkey occludes itself: a map, not a blank image
+    np.testing.assert_array_equal(modal, blocking)
 
 
 def test_undo_restores_the_scene(scene):
@@ -244,7 +257,7 @@ def test_esc_during_the_unwrap_stops_xatlas_and_changes_nothing(scene):
     from hao_addon.blender.bake_job import BakeJob
     import time
 
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=192, ring_count=96)  # ~36k triangles: seconds of xatlas
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=640, ring_count=320)  # 409,600 triangles: seconds of unwrap
     obj = bpy.context.active_object
     obj.data.uv_layers.remove(obj.data.uv_layers[0])
     images_before = set(bpy.data.images.keys())
@@ -252,7 +265,7 @@ def test_esc_during_the_unwrap_stops_xatlas_and_changes_nothing(scene):
     runner = ModalBakeRunner(job)
     assert runner.tick(budget_s=0.3) is False
     assert runner.fraction == 0.0 and runner.status.startswith("Unwrapping 'Sphere'")
-    assert unwrap_children()  # xatlas runs in a child process, so the UI keeps ticking
+    assert unwrap_children()  # the unwrap runs in a child process, so the UI keeps ticking
     t0 = time.monotonic()
     runner.cancel()
     assert time.monotonic() - t0 < 1.0 and unwrap_children() == []

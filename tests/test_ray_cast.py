@@ -13,7 +13,7 @@ import pytest
 from hao_addon.bakers import RAY_CASTS, ray_caster_for
 from hao_addon.core import scenes
 from hao_addon.core.bake import ray_grid
-from hao_addon.core.bake.projection import drain
+from hao_addon.core.steps import drain
 from hao_addon.core.bake.ray_grid import build_grid
 from hao_addon.core.objfile import read_obj
 from hao_addon.gpu.util import live_pass_count

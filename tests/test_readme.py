@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""What the README states about the code stays true: its snippet runs, its counts match."""
+"""What the README and the manual state about the code stays true: their snippets run, their
+counts match, their links lead somewhere."""
 from __future__ import annotations
 
 import re
@@ -9,14 +10,37 @@ import numpy as np
 from conftest import ROOT
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
+BAKING_PAGE = (ROOT / "docs" / "baking-in-blender.md").read_text(encoding="utf-8")
+COMMAND_LINE_PAGE = (ROOT / "docs" / "command-line.md").read_text(encoding="utf-8")
 
 
-def test_core_api_snippet_runs_as_written(gpu_context, monkeypatch):
-    block = re.search(r"blocking \(`execute`\)\. The core is also callable.*?```python\n(.*?)```", README, re.S)
-    assert block, "README lost its core-API snippet"
+def test_readme_first_bake_from_python_runs_as_written(gpu_context, monkeypatch, capsys):
+    block = re.search(r"## A first bake from Python.*?```python\n(.*?)```", README, re.S)
+    assert block, "README lost its Python snippet"
     monkeypatch.chdir(ROOT)
     namespace: dict = {}
     exec(compile(block.group(1), "README.md", "exec"), namespace)  # noqa: S102 - our own README
+    assert namespace["result"].ao.shape == (512, 512)
+    assert capsys.readouterr().out.startswith("(512, 512) ")
+
+
+def test_readme_links_lead_to_files_and_headings():
+    for target, anchor in re.findall(r"\]\(((?:docs/)[^)#]+)(?:#([^)]+))?\)", README):
+        assert (ROOT / target).is_file(), target
+        if anchor and target.endswith(".md"):
+            text = (ROOT / target).read_text(encoding="utf-8")
+            slugs = {re.sub(r"[^a-z0-9 -]", "", h.lower()).strip().replace(" ", "-")
+                     for h in re.findall(r"^#+ (.*?)(?: \{#.*\})?$", text, re.M)}
+            slugs |= set(re.findall(r"\{#([a-z0-9-]+)\}", text))
+            assert anchor in slugs, (target, anchor)
+
+
+def test_core_api_snippet_runs_as_written(gpu_context, monkeypatch):
+    block = re.search(r"blocking \(`execute`\)\. The core is also callable.*?```python\n(.*?)```", BAKING_PAGE, re.S)
+    assert block, "the manual lost its core-API snippet"
+    monkeypatch.chdir(ROOT)
+    namespace: dict = {}
+    exec(compile(block.group(1), "baking-in-blender.md", "exec"), namespace)  # noqa: S102 - our own manual
     result = namespace["result"]
     assert result.ao.shape == (1024, 1024) and result.ao.dtype == np.float32 and "covered_texels" in result.stats
     assert namespace["per_vertex"].ao.shape == (len(namespace["v"]),)
@@ -26,7 +50,7 @@ def test_core_api_snippet_runs_as_written(gpu_context, monkeypatch):
 
 def test_bad_input_class_count_is_the_suite_s():
     import test_bad_input
-    stated = int(re.search(r"`tests/test_bad_input\.py` tries (\d+) classes", README).group(1))
+    stated = int(re.search(r"`tests/test_bad_input\.py` tries (\d+) classes", COMMAND_LINE_PAGE).group(1))
     operator_cases = sum(len(m.args[1]) for f in (test_bad_input.test_bake_operator_bad_input,
                                                   test_bad_input.test_render_operator_bad_input)
                          for m in f.pytestmark if m.name == "parametrize")

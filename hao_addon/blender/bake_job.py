@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import compat
 from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
+from ..core.steps import relay
 from ..core.bake.error_estimate import estimate
 from ..verify import verify_steps
 from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
@@ -74,7 +75,7 @@ class BakeRequest:
     """targets: mesh objects to bake. occluders: 'TARGET' (self only), 'SELECTED' (the other
     selected meshes too) or 'VISIBLE' (every visible mesh). uv_map: a UV map name, '' for the
     active render UV map, or 'AUTO': AO_UV if present, else the first UV map, else a new
-    AO_UV unwrapped with xatlas.
+    AO_UV unwrapped automatically (core/bake/unwrap.py).
     image: an existing image to overwrite (one target only), else '<object>_AO' is created.
     filepath: '' or a .png/.exr path; '{object}' in it becomes each object's name (with several
     targets and no token, '_{object}' is appended).
@@ -189,7 +190,7 @@ def validate_request(request: BakeRequest) -> None:
         if name not in ("", "AUTO") and name not in obj.data.uv_layers:
             raise BakeInputError(f"'{obj.name}' has no UV map named '{name}'")
         if name == "" and not obj.data.uv_layers:
-            raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto (xatlas) to unwrap it")
+            raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto to unwrap it")
     request.options.validated()
     if request.frames is not None:
         _validate_frames(request)
@@ -362,14 +363,7 @@ def _validate_high_to_low(request: BakeRequest) -> None:
 
 def _with_status(steps: Generator, fraction: float, text: str) -> Generator[tuple[float, str], None, object]:
     """Re-yield a generator's steps as (fraction, text); return its value; close it on exit."""
-    try:
-        while True:
-            next(steps)
-            yield fraction, text
-    except StopIteration as stop:
-        return stop.value
-    finally:
-        steps.close()
+    return (yield from relay(steps, lambda _step: (fraction, text)))
 
 
 class BakeJob:
@@ -403,7 +397,7 @@ class BakeJob:
 
     # -- preparation -----------------------------------------------------------------------
     def _uv_name_for(self, obj) -> Generator[tuple[float, str], None, str]:
-        """The UV map to bake into (yields while xatlas unwraps a mesh that has none)."""
+        """The UV map to bake into (yields while a mesh that has none is unwrapped)."""
         mesh = obj.data
         name = self.request.uv_map
         if name == "":
@@ -418,7 +412,7 @@ class BakeJob:
         positions, tris, tri_loops = mesh_data.base_mesh_triangles(obj)
         unwrap = unwrap_steps(positions, tris, self.request.settings.size, name=obj.name)
         t0 = time.perf_counter()
-        uvs = yield from _with_status(unwrap, 0.0, f"Unwrapping '{obj.name}' (xatlas)")
+        uvs = yield from _with_status(unwrap, 0.0, f"Unwrapping '{obj.name}'")
         self.unwrap_seconds += time.perf_counter() - t0
         new_name = mesh_data.add_uv_layer(mesh, mesh_data.AO_UV_NAME, tri_loops, uvs)
         self.created_uv.append((mesh, new_name))
@@ -548,18 +542,11 @@ class BakeJob:
                     yield start + share * (k + 1) / len(units), f"Reusing frame {earlier} for '{label}'{at}"
                     continue
             # A sequence bakes past the shared cache: it would hold up to its size in maps.
-            gen = bake_steps(target, occluders, settings, use_cache=frame is None)
-            try:
-                while True:
-                    try:
-                        frac = next(gen)
-                    except StopIteration as stop:
-                        result = stop.value
-                        break
-                    yield (start + share * (k + frac) / len(units),
-                           f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%")
-            finally:
-                gen.close()  # on cancel: runs bake_steps' finally, which frees the GPU pass now
+            # (relay closes it on cancel: bake_steps' finally frees the GPU pass now.)
+            result = yield from relay(bake_steps(target, occluders, settings, use_cache=frame is None),
+                                      lambda frac, k=k, label=label, at=at: (
+                                          start + share * (k + frac) / len(units),
+                                          f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%"))
             if req.options.verify:
                 check = yield from _with_status(verify_steps(target, occluders, settings, result, req.options.verify),
                                                 start + share * (k + 1) / len(units),

@@ -2,5 +2,14 @@
 """Errors the core raises for input a user can fix (every interface reports them as one line)."""
 
 
-class BakeInputError(ValueError):
-    """The input cannot be baked or rendered; the message says why in words a user can act on."""
+class UserInputError(ValueError):
+    """Input that cannot be used; the message says why in words a user can act on. Every
+    interface catches this one class (the command line: exit 2; operators: one report)."""
+
+
+class BakeInputError(UserInputError):
+    """The input cannot be baked."""
+
+
+class ViewInputError(UserInputError):
+    """The scene or view cannot be rendered with viewport AO (HAO)."""

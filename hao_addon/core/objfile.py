@@ -44,15 +44,15 @@ def read_obj(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | Non
 
 
 def obj_soup(path: str | Path, uvs: str = "file", size: int = 1024) -> TriangleSoup:
-    """A TriangleSoup from an OBJ. uvs: 'file' (must have them), 'xatlas' (unwrap) or 'none'."""
+    """A TriangleSoup from an OBJ. uvs: 'file' (must have them), 'auto' (unwrap: core/bake/unwrap.py) or 'none'."""
     v, t, uv, tu = read_obj(path)
     if uvs == "file":
         if uv is None:
             raise ValueError(f"{path} has no UVs")
         corner_uv = uv[tu]
-    elif uvs == "xatlas":
-        from .bake.unwrap import xatlas_unwrap
-        corner_uv = xatlas_unwrap(v, t, size)
+    elif uvs == "auto":
+        from .bake.unwrap import unwrap_in_process
+        corner_uv = unwrap_in_process(v, t, size)
     else:
         corner_uv = None
     return TriangleSoup(v[t], corner_uv, name=Path(path).stem)

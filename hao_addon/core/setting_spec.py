@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """One definition per setting: a dataclass field carries its default and a ``Spec`` (label,
 description, range, unit, choices). The Blender properties (``operators/setting_props.py``),
-the command-line options (``hao_addon/cli_options.py``) and the README's option tables
-(``tools/readme_tables.py``) are generated from it, and ``validate`` is the only range check.
+the command-line options (``hao_addon/cli_options.py``) and the manual's settings page
+(``tools/docs_pages.py``) are generated from it, and ``validate`` is the only range check.
 """
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Iterator
 
-from .errors import BakeInputError
+from .errors import UserInputError
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ def _fmt(x: float) -> str:
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
-class SettingError(BakeInputError):
+class SettingError(UserInputError):
     """A setting is out of range or of the wrong kind; ``name`` is the dataclass field."""
 
     def __init__(self, name: str, message: str) -> None:

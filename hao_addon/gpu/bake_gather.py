@@ -33,12 +33,12 @@ from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, b
                                      normal_bins, octahedral_coords, proximity_order)
 from ..core.errors import BakeInputError
 from ..core.directions import replicate_sizes
-from ..core.bake.estimators import AMBIENT_OCCLUSION, Estimator, texel_sums
+from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
 from . import util
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, glsl_struct, shader_variants
 
 # The list textures' row width (util.LIST_WIDTH); the compute grid is LIST_WIDTH / 64 groups wide.
 LIST_WIDTH = util.LIST_WIDTH
@@ -98,6 +98,8 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
     return info
 
 
+@shader_variants(valid=lambda a: a["shading"] or not a["terminator"],
+                 fill=(False, True), shading=(False, True), terminator=(False, True))
 def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = False) -> "gpu.types.GPUShader":
     """shading: entries carry the shading and the face normal (plan.smooth_shading);
     terminator: and their terminator lift (plan.lifts_terminator)."""
@@ -116,9 +118,15 @@ def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = Fals
 # guarantees 16 of those (GL_MAX_COMPUTE_TEXTURE_IMAGE_UNITS).
 VIEWS_PER_DISPATCH = 16
 DEPTH_BATCH_BYTES = 64 << 20
-# The GatherViews uniform block (gpu_shaders/bake_gather_views.glsl, std140): its arrays hold
-# GATHER_MAX_VIEWS entries (a GLSL define of the same name), VIEWS_PER_DISPATCH <= that of them
-# used; mat4 columns and vec4s need no padding.
+# The light views of one gather dispatch: the GatherViews uniform block, whose GLSL struct is
+# generated from this dtype (shaders.glsl_struct; std140, mat4 and vec4 arrays need no
+# padding). Its arrays hold GATHER_MAX_VIEWS entries (also a GLSL define), VIEWS_PER_DISPATCH
+# <= that of them used. view_proj maps normalized world to the view's clip space; plane_slope.xy
+# turns the image of a plane's normal under it into the plane's depth change per pixel
+# (core/bake/views.OrthoView.plane_slope); omega points towards the light; view_info is
+# (width, height, one pixel's extent in depth units, the depth range in normalized units). A
+# uniform buffer, because four views' push constants would pass the 128 bytes some backends
+# guarantee.
 GATHER_MAX_VIEWS = 16
 GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
                                ("plane_slope", "<f4", (GATHER_MAX_VIEWS, 4)),
@@ -211,7 +219,7 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         info.define("ALPHA_TAPS", "1")
     info.push_constant('INT', "first_entry")
     info.push_constant('INT', "entry_end")
-    info.typedef_source(glsl_source("bake_gather_views.glsl"))
+    info.typedef_source(glsl_struct("GatherViews", GATHER_VIEWS_DTYPE))
     info.uniform_buf(0, "GatherViews", "views")
     info.image(0, 'RGBA32F', 'FLOAT_2D', "entry_position", qualifiers={'READ'})
     info.image(1, 'RGBA32F', 'FLOAT_2D', "entry_normal", qualifiers={'READ'})
@@ -235,6 +243,10 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
     return info
 
 
+@shader_variants(valid=lambda a: (a["shading"] or not a["terminator"]) and (a["falloff"] is None or a["views"] == 1),
+                 uniform=(False, True), views=(GATHER_MAX_VIEWS, 4, 1), shading=(False, True),
+                 falloff=(None, "none", "wendland"), terminator=(False, True),
+                 estimator=(AMBIENT_OCCLUSION, BENT_NORMALS), spread_cos=(0.0, 0.5), alpha_taps=(False, True))
 def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
                   terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION,
                   spread_cos: float = 0.0, alpha_taps: bool = False) -> "gpu.types.GPUShader":

@@ -18,7 +18,7 @@ from ..core.bake.projection import barycentric_from_uv
 from ..core.bake.ray_grid import UniformGrid, build_grid
 from ..core.errors import BakeInputError
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 LIST_WIDTH = util.LIST_WIDTH  # the list textures' rows; the compute grid is LIST_WIDTH / GROUP_SIZE wide
 GROUP_SIZE = 64
@@ -49,6 +49,7 @@ def _ray_cast_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants()
 def ray_cast_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_ray_cast",), _ray_cast_info)
 

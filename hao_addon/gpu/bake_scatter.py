@@ -30,7 +30,7 @@ from ..core.bake.plan import BakePlan
 from . import util
 from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
                          soup_shader_info)
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 CHUNK_DIRECTIONS = 16
 CHUNK_TARGET = 2.0**12  # expected denominator per texel per chunk, in fixed-point units
@@ -73,6 +73,8 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
     return info
 
 
+@shader_variants(uniform=(False, True), layered=(False, True), wendland=(False, True),
+                 footprint=(False, True), shading=(False, True), spread_cos=(0.0, 0.5))
 def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
                  shading: bool = False, spread_cos: float = 0.0) -> "gpu.types.GPUShader":
     """shading: weight by interpolated shading normals, with the terminator rule (plan.smooth_shading);

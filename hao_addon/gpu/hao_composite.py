@@ -7,7 +7,7 @@ import numpy as np
 
 from .. import compat
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 
 def _composite_info() -> "gpu.types.GPUShaderCreateInfo":
@@ -27,13 +27,19 @@ def _composite_info() -> "gpu.types.GPUShaderCreateInfo":
 _TRIANGLE = None
 
 
+@shader_variants()
+def composite_shader() -> "gpu.types.GPUShader":
+    """Darkens the viewport's colour by the AO (draw_composite)."""
+    return cached_shader(("hao_composite",), _composite_info)
+
+
 def draw_composite(ao_tex, depth_tex, strength: float, region_offset: tuple[int, int] = (0, 0)) -> None:
     """Darken the bound framebuffer by the AO: colour * (1 - (1 - AO) * strength), depth tested
     LESS_EQUAL against the bound depth buffer (see hao_composite.frag)."""
     global _TRIANGLE
     if _TRIANGLE is None:
         _TRIANGLE = util.make_batch('TRIS', {"corner": ('F32', np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]]))})
-    shader = cached_shader(("hao_composite",), _composite_info)
+    shader = composite_shader()
     with util.scoped_state():
         gpu.state.blend_set('ALPHA')
         gpu.state.depth_test_set('LESS_EQUAL')
@@ -45,7 +51,3 @@ def draw_composite(ao_tex, depth_tex, strength: float, region_offset: tuple[int,
         shader.uniform_sampler("depth_tex", depth_tex)
         _TRIANGLE.draw(shader)
 
-
-def free_composite() -> None:
-    global _TRIANGLE
-    _TRIANGLE = None

@@ -7,7 +7,7 @@ import gpu
 import numpy as np
 
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 
 def _gbuffer_info(back_layer: bool) -> "gpu.types.GPUShaderCreateInfo":
@@ -30,6 +30,7 @@ def _gbuffer_info(back_layer: bool) -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants(back_layer=(False, True))
 def gbuffer_shader(back_layer: bool = False) -> "gpu.types.GPUShader":
     return cached_shader(("hao_gbuffer", back_layer), lambda: _gbuffer_info(back_layer))
 

@@ -22,11 +22,12 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
+from typing import Any, Callable
 
 import gpu
 import numpy as np
 
-from ..core.errors import BakeInputError
+from ..core.errors import ViewInputError
 from ..core.hao.cascades import Focus, cascade_specs, focus_from_depth
 from ..core.hao.methods import MethodPlan, method_plan
 from ..core.hao.view_scene import SceneObject, filled_classes, render_anchor, scene_bounds
@@ -46,35 +47,17 @@ FRAME_INPUTS = ("geometry", "region", "grid", "view", "spheres")
 
 @dataclass(frozen=True)
 class PassSpec:
-    """reads: FRAME_INPUTS and resources (a pass name, or
-    AO_MAP) whose keys its key includes; settings: ViewAOSettings fields it depends on;
-    writes: the resource it leaves (its own name, or AO_MAP); stat: its counter in stats."""
+    """run: the renderer's runner of the pass (renderer, frame) -> its output key or None;
+    reads: FRAME_INPUTS and resources (a pass name, or AO_MAP) whose keys its key includes;
+    settings: ViewAOSettings fields it depends on; writes: the resource it leaves (its own
+    name, or AO_MAP); stat: its counter in stats."""
+    run: Callable[["HaoRenderer", "Frame"], Any]
     reads: tuple[str, ...]
     settings: tuple[str, ...]
     stat: str
     writes: str = ""
 
 
-PASSES = {
-    "upload": PassSpec(("geometry",), (), "upload"),
-    # Where the cascades go (core/hao/cascades.py): its key for the passes after it is the
-    # placement it chose, which a small camera move leaves unchanged.
-    "cascades": PassSpec(("gbuffer", "region"), ("grid", "cascades", "march", "max_distance"), "cascades"),
-    # Not the upload: the grid's key names the cascades and the objects reaching into each
-    # (one changing outside a user region, or outside a cascade, is not voxelized again).
-    "voxelize": PassSpec(("cascades", "grid"), (), "voxelize"),
-    "gbuffer": PassSpec(("upload", "view"), (), "gbuffer"),
-    "back_layer": PassSpec(("upload", "view"), (), "back_layer"),
-    "low_gbuffer": PassSpec(("gbuffer",), ("scale",), "low_gbuffer"),
-    "voxel_ao": PassSpec(("gbuffer", "voxelize"), ("scale", "rays", "steps", "march", "spread", "max_distance",
-                                                   "falloff"), "ao", AO_MAP),
-    "near_field": PassSpec(("gbuffer", "back_layer"), ("scale", "rays", "max_distance", "falloff", "near_radius",
-                                                       "method"), "near", AO_MAP),
-    "open_ao": PassSpec(("gbuffer",), ("scale",), "open_ao", AO_MAP),
-    "spheres": PassSpec((AO_MAP, "low_gbuffer", "spheres", "region"), ("epsilon", "max_distance", "falloff",
-                                                                       "near_radius", "method"), "far", AO_MAP),
-    "filter": PassSpec((AO_MAP, "low_gbuffer", "region"), ("filter_size", "max_distance"), "filter"),
-}
 
 
 # The bilateral filter's position weight reaches 0 at d_max; at unlimited distance at this
@@ -144,10 +127,10 @@ class HaoRenderer(util.GPUPass):
 
     def _render(self, objects, view_proj, width, height, settings, region, spheres) -> None:
         if width < 1 or height < 1:
-            raise BakeInputError(f"image size must be positive, got {width}x{height}")
+            raise ViewInputError(f"image size must be positive, got {width}x{height}")
         plan = method_plan(settings.method)
         if plan.spheres and spheres is None:
-            raise BakeInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
+            raise ViewInputError(f"method '{settings.method}' needs sphere proxies: sync them first")
         self.stats["frames"] += 1
         inputs, frame = self._frame_inputs(plan, objects, view_proj, width, height, settings, region, spheres)
         self._sequence(plan, inputs, frame)
@@ -161,7 +144,7 @@ class HaoRenderer(util.GPUPass):
         world_bounds = scene_bounds(objects, self._boxes)
         bounds = region if region is not None else world_bounds
         if bounds is None:
-            raise BakeInputError("nothing to render: no visible mesh objects")
+            raise ViewInputError("nothing to render: no visible mesh objects")
         # Everything on the GPU is measured from the anchor (float32 precision far from the
         # origin); G-buffer positions read back are relative to it (self.anchor).
         anchor = render_anchor(*(world_bounds if world_bounds is not None else bounds))
@@ -216,13 +199,14 @@ class HaoRenderer(util.GPUPass):
             key = (name, tuple(read(r) for r in spec.reads), tuple(getattr(frame.settings, f) for f in spec.settings))
             resource = spec.writes or name
             if self._state.get(resource) != key:
-                output = getattr(self, "_run_" + name)(frame)
+                output = spec.run(self, frame)
                 self._state[resource] = key
                 self._outputs[resource] = key if output is None else output
                 self.stats[spec.stat] += 1
             keys[resource] = self._outputs.get(resource, key)
 
-    # The passes (PASSES): each runs unconditionally; the sequencer decides when.
+    # The passes' runners (rows of PASSES, below): each runs unconditionally; the sequencer
+    # decides when.
 
     def _run_upload(self, frame: Frame) -> None:
         anchor = self.anchor
@@ -312,3 +296,29 @@ class HaoRenderer(util.GPUPass):
         for p in (self.voxels, self.gbuffer, self.sampling, self.filter, self.far, self.back, self.low_gbuffer):
             p.free()
         self._state.clear()
+
+
+# The passes, one row each (PassSpec): its runner, what it reads, the settings it depends on,
+# its counter and what it writes. A method (core/hao/methods.py) is a list of these names.
+PASSES = {
+    "upload": PassSpec(HaoRenderer._run_upload, ("geometry",), (), "upload"),
+    # Where the cascades go (core/hao/cascades.py): its key for the passes after it is the
+    # placement it chose, which a small camera move leaves unchanged.
+    "cascades": PassSpec(HaoRenderer._run_cascades, ("gbuffer", "region"),
+                         ("grid", "cascades", "march", "max_distance"), "cascades"),
+    # Not the upload: the grid's key names the cascades and the objects reaching into each
+    # (one changing outside a user region, or outside a cascade, is not voxelized again).
+    "voxelize": PassSpec(HaoRenderer._run_voxelize, ("cascades", "grid"), (), "voxelize"),
+    "gbuffer": PassSpec(HaoRenderer._run_gbuffer, ("upload", "view"), (), "gbuffer"),
+    "back_layer": PassSpec(HaoRenderer._run_back_layer, ("upload", "view"), (), "back_layer"),
+    "low_gbuffer": PassSpec(HaoRenderer._run_low_gbuffer, ("gbuffer",), ("scale",), "low_gbuffer"),
+    "voxel_ao": PassSpec(HaoRenderer._run_voxel_ao, ("gbuffer", "voxelize"),
+                         ("scale", "rays", "steps", "march", "spread", "max_distance", "falloff"), "ao", AO_MAP),
+    "near_field": PassSpec(HaoRenderer._run_near_field, ("gbuffer", "back_layer"),
+                           ("scale", "rays", "max_distance", "falloff", "near_radius", "method"), "near", AO_MAP),
+    "open_ao": PassSpec(HaoRenderer._run_open_ao, ("gbuffer",), ("scale",), "open_ao", AO_MAP),
+    "spheres": PassSpec(HaoRenderer._run_spheres, (AO_MAP, "low_gbuffer", "spheres", "region"),
+                        ("epsilon", "max_distance", "falloff", "near_radius", "method"), "far", AO_MAP),
+    "filter": PassSpec(HaoRenderer._run_filter, (AO_MAP, "low_gbuffer", "region"), ("filter_size", "max_distance"),
+                       "filter"),
+}

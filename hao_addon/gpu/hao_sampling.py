@@ -11,13 +11,16 @@ from ..core.hao.voxel_grid import level_count
 from ..core.hao.view_settings import ViewAOSettings
 from . import util
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
-from .shaders import add_defines, cached_shader, glsl_source
+from .shaders import add_defines, cached_shader, glsl_source, glsl_struct, shader_variants
 
 GROUP = 8
 
 
-# The HaoCascades uniform block (gpu_shaders/hao_cascades.glsl, std140: arrays of vec4 and
-# ivec4 need no padding).
+# The cascades of the AO pass: the HaoCascades uniform block, whose GLSL struct is generated
+# from this dtype (shaders.glsl_struct; std140: arrays of vec4 and ivec4 need no padding), up
+# to MAX_CASCADES (core/hao/cascades.py), finest first, each inside the next. origin_voxel is
+# the grid's corner (anchor-relative world) and voxel size, dims its voxels and (w) pyramid
+# levels, atlas.x its row in the grid texture; count.x how many are used.
 CASCADES_DTYPE = np.dtype([("origin_voxel", "<f4", (MAX_CASCADES, 4)), ("dims", "<i4", (MAX_CASCADES, 4)),
                            ("atlas", "<i4", (MAX_CASCADES, 4)), ("count", "<i4", (4,))])
 
@@ -48,7 +51,7 @@ def _ao_info(march: str, falloff: str) -> "gpu.types.GPUShaderCreateInfo":
         info.define("WENDLAND_FALLOFF", "1")
     info.define("MARCH_NUDGE", repr(MARCH_NUDGE))
     info.define("MAX_CASCADES", str(MAX_CASCADES))
-    info.typedef_source(glsl_source("hao_cascades.glsl"))
+    info.typedef_source(glsl_struct("HaoCascades", CASCADES_DTYPE))
     info.uniform_buf(0, "HaoCascades", "cascades")
     info.push_constant('IVEC2', "full_size")
     info.push_constant('INT', "scale")
@@ -112,7 +115,7 @@ class LowGBufferPass(util.GPUPass):
             self.position = gpu.types.GPUTexture(low, format='RGBA32F')
             self.normal = gpu.types.GPUTexture(low, format='RGBA32F')
             self.size = low
-        shader = cached_shader(("hao_pick_low",), _pick_low_info)
+        shader = pick_low_shader()
         shader.bind()
         shader.uniform_int("full_size", (width, height))
         shader.uniform_int("scale", scale)
@@ -127,10 +130,18 @@ class LowGBufferPass(util.GPUPass):
         self.size = (0, 0)
 
 
+@shader_variants()
+def pick_low_shader() -> "gpu.types.GPUShader":
+    """Picks each AO-map pixel's G-buffer sample (the low-resolution G-buffer)."""
+    return cached_shader(("hao_pick_low",), _pick_low_info)
+
+
+@shader_variants(march=("hierarchical", "fixed"), falloff=("none", "wendland"))
 def ao_shader(march: str, falloff: str) -> "gpu.types.GPUShader":
     return cached_shader(("hao_ao", march, falloff), lambda: _ao_info(march, falloff))
 
 
+@shader_variants(axis=(0, 1), upsample=(False, True))
 def bilateral_shader(axis: int, upsample: bool) -> "gpu.types.GPUShader":
     return cached_shader(("hao_bilateral", axis, upsample), lambda: _bilateral_info(axis, upsample))
 

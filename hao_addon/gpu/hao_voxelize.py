@@ -12,7 +12,7 @@ from ..core.hao.cascades import atlas_layout
 from ..core.hao.view_scene import NEARLY_CLOSED, OPEN
 from ..core.hao.voxel_grid import GridSpec, atlas_words, level_count, level_dims, level_offsets
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 
 def _voxelize_info(solid: bool) -> "gpu.types.GPUShaderCreateInfo":
@@ -35,6 +35,25 @@ def _voxelize_info(solid: bool) -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants()
+def clear_box_shader() -> "gpu.types.GPUShader":
+    """Clears one cascade's box of the grid texture."""
+    return cached_shader(("hao_clear_box",), _clear_info)
+
+
+@shader_variants()
+def pyramid_shader() -> "gpu.types.GPUShader":
+    """Builds one level of a cascade's occupancy pyramid from the level below."""
+    return cached_shader(("hao_pyramid",), _pyramid_info)
+
+
+@shader_variants()
+def unpack_shader() -> "gpu.types.GPUShader":
+    """Copies a 3D grid level into 2D for reading back (tests)."""
+    return cached_shader(("hao_unpack",), _unpack_info)
+
+
+@shader_variants(solid=(False, True))
 def voxelize_shader(solid: bool) -> "gpu.types.GPUShader":
     return cached_shader(("hao_voxelize", solid), lambda: _voxelize_info(solid))
 
@@ -179,7 +198,7 @@ class VoxelPass(util.GPUPass):
 
     def _clear_cascade(self, i: int) -> None:
         words = atlas_words(self.specs[i].dims)
-        shader = cached_shader(("hao_clear_box",), _clear_info)
+        shader = clear_box_shader()
         shader.bind()
         shader.image("grid", self.grid)
         shader.uniform_int("box", (words[0], self.y_offsets[i], self.y_offsets[i] + words[1], words[2]))
@@ -220,7 +239,7 @@ class VoxelPass(util.GPUPass):
 
     def _build_pyramid(self, i: int) -> None:
         dims = self.specs[i].dims
-        shader = cached_shader(("hao_pyramid",), _pyramid_info)
+        shader = pyramid_shader()
         shader.bind()
         shader.image("grid", self.grid)
         shader.uniform_int("atlas_y", self.y_offsets[i])
@@ -238,7 +257,7 @@ class VoxelPass(util.GPUPass):
         dims = self.specs[cascade].dims
         nx, ny, nw, x0 = _level_words(dims, level)
         flat = gpu.types.GPUTexture((nx, ny * nw), format='R32UI')
-        shader = cached_shader(("hao_unpack",), _unpack_info)
+        shader = unpack_shader()
         shader.bind()
         shader.uniform_int("grid_dims", (nx, ny, nw, x0))
         shader.uniform_int("atlas_y", self.y_offsets[cascade])

@@ -9,7 +9,7 @@ import numpy as np
 from ..core.bake.plan import BakePlan
 from ..core.bake.views import OrthoView
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 
 def soup_shader_info(name: str, vertex_file: str, varyings: tuple[tuple[str, str, str], ...],
@@ -55,6 +55,7 @@ def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants()
 def layers_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_layers", LAYERS), _layers_info)
 
@@ -85,6 +86,7 @@ def _depth_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants()
 def depth_shader() -> "gpu.types.GPUShader":
     return cached_shader(("bake_depth",), _depth_info)
 
@@ -99,6 +101,7 @@ def _depth_positions_info() -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants()
 def depth_positions_shader() -> "gpu.types.GPUShader":
     """Depth-only drawing of a positions_batch."""
     return cached_shader(("bake_depth_positions",), _depth_positions_info)
@@ -131,6 +134,7 @@ def _alpha_info(fragment: str, layered: bool) -> "gpu.types.GPUShaderCreateInfo"
     return info
 
 
+@shader_variants(layered=(False, True))
 def alpha_shader(layered: bool) -> "gpu.types.GPUShader":
     """The depth pass (or, layered, the depth-list pass) that leaves out what the light passes."""
     if layered:

@@ -10,7 +10,7 @@ from ..core.hao.ao_pattern import GLSL_DEFINES
 from ..core.proxies.near_field import camera_terms
 from .hao_sampling import GROUP
 from .hao_gbuffer import bind_gbuffer_images, declare_gbuffer_images
-from .shaders import add_defines, cached_shader, glsl_source
+from .shaders import add_defines, cached_shader, glsl_source, shader_variants
 
 
 def _near_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
@@ -35,6 +35,7 @@ def _near_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants(falloff=("none", "wendland"))
 def near_shader(falloff: str = "wendland") -> "gpu.types.GPUShader":
     return cached_shader(("hao_near_field", falloff), lambda: _near_info(falloff))
 

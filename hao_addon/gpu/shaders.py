@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Callable
 
 import gpu
+import numpy as np
 
 SHADER_DIR = Path(__file__).resolve().parent.parent.parent / "gpu_shaders"
 
@@ -37,6 +38,30 @@ def load_glsl(name: str) -> str:
 def glsl_source(*names: str) -> str:
     """Concatenate shader files in the given order (shared snippets first)."""
     return "\n".join(f"/* --- {n} --- */\n{load_glsl(n)}" for n in names)
+
+
+# std140 members a numpy dtype field can stand for: (kind, trailing shape) -> GLSL type.
+# Arrays of these need no padding under std140 (a stride of 16 or 64 bytes).
+_STD140_TYPES = {("f", (4, 4)): "mat4", ("f", (4,)): "vec4", ("i", (4,)): "ivec4"}
+
+
+def glsl_struct(name: str, dtype: np.dtype) -> str:
+    """The GLSL struct of a uniform block whose bytes are `dtype` (one definition: the block's
+    layout is the dtype, its GLSL is generated). Fields: float32 or int32 arrays of shape
+    (4,), (4, 4), (N, 4) or (N, 4, 4), at std140 offsets (checked)."""
+    lines, offset = [], 0
+    for field in dtype.names:
+        base, at = dtype.fields[field][:2]
+        kind, shape = base.base.kind, base.shape
+        glsl = _STD140_TYPES.get((kind, shape[-2:] if len(shape) >= 2 and shape[-2:] == (4, 4) else shape[-1:]))
+        if glsl is None or base.base.itemsize != 4 or at != offset:
+            raise TypeError(f"{name}.{field}: {base} at byte {at} has no std140 GLSL member")
+        count = shape[:-2] if glsl == "mat4" else shape[:-1]
+        lines.append(f"  {glsl} {field}{''.join(f'[{n}]' for n in count)};")
+        offset += base.itemsize
+    if offset != dtype.itemsize:
+        raise TypeError(f"{name}: {dtype.itemsize - offset} bytes of padding at the end")
+    return f"struct {name} {{\n" + "\n".join(lines) + "\n};\n"
 
 
 def add_defines(info: "gpu.types.GPUShaderCreateInfo", defines: dict[str, float | int]) -> None:
@@ -70,6 +95,48 @@ def compile_with_log(info: "gpu.types.GPUShaderCreateInfo", label: str) -> "gpu.
             raise ShaderCompileError(f"shader '{label}' failed to compile: {exc}\n{log}") from None
 
 
+# Every shader factory, with the values each of its parameters takes (shader_variants):
+# the tests compile every variant from this list, not from a list of their own.
+SHADER_FACTORIES: list[tuple[Callable, dict[str, tuple]]] = []
+_VALID: dict[Callable, Callable[[dict], bool]] = {}
+# Up to this many variants a factory's parameters are combined in full; beyond it, each value
+# of each parameter once (beside the defaults) and all of them at their last value together.
+FULL_PRODUCT_LIMIT = 16
+
+
+def shader_variants(valid: Callable[[dict], bool] | None = None, **domains: tuple) -> Callable:
+    """Declare a shader factory and the values each parameter takes (its variants); valid:
+    which combinations exist (the terminator lift needs shading normals, say)."""
+    def register(factory: Callable) -> Callable:
+        SHADER_FACTORIES.append((factory, domains))
+        if valid is not None:
+            _VALID[factory] = valid
+        return factory
+    return register
+
+
+def variant_arguments(factory: Callable, domains: dict[str, tuple]) -> list[dict]:
+    """The argument sets of a factory's variants to compile: all combinations up to
+    FULL_PRODUCT_LIMIT, else every value of every parameter once (on the defaults where that
+    combination exists, else on the first that does) and all parameters at their last value.
+    Combinations the factory's `valid` rules out are left out."""
+    import itertools
+    valid = _VALID.get(factory, lambda _arguments: True)
+    names = list(domains)
+    product = [dict(zip(names, values)) for values in itertools.product(*(domains[n] for n in names))]
+    if len(product) <= FULL_PRODUCT_LIMIT:
+        return [arguments for arguments in product if valid(arguments)]
+    base, last = ({n: domains[n][0] for n in names}, {n: domains[n][-1] for n in names})
+    kept = [last] if valid(last) else []
+    for name in names:
+        for value in domains[name]:
+            chosen = next((a for a in [{**base, name: value}, {**last, name: value}] + product
+                           if a[name] == value and valid(a)), None)
+            if chosen is not None and chosen not in kept:
+                kept.append(chosen)
+    return kept
+
+
 _SHADER_CACHE: dict[tuple, "gpu.types.GPUShader"] = {}
 
 
@@ -89,3 +156,14 @@ def free_shaders() -> None:
 
 def cached_shader_count() -> int:
     return len(_SHADER_CACHE)
+
+
+@shader_variants()
+def barrier_shader() -> "gpu.types.GPUShader":
+    """An empty compute dispatch (util.memory_barrier's fence)."""
+    def build():
+        info = gpu.types.GPUShaderCreateInfo()
+        info.local_group_size(1, 1, 1)
+        info.compute_source("void main() {}")
+        return info
+    return cached_shader(("barrier",), build)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.proxies.sphere_ao import far_distance
 from . import util
-from .shaders import cached_shader, glsl_source
+from .shaders import cached_shader, glsl_source, shader_variants
 
 
 def _far_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
@@ -37,6 +37,7 @@ def _far_info(falloff: str) -> "gpu.types.GPUShaderCreateInfo":
     return info
 
 
+@shader_variants(falloff=("none", "wendland"))
 def far_shader(falloff: str = "wendland") -> "gpu.types.GPUShader":
     return cached_shader(("hao_sphere_far", falloff), lambda: _far_info(falloff))
 

@@ -61,20 +61,21 @@ def check_texture_limits(map_size: int, view_side: int, bytes_needed: int) -> No
 
 
 def check_render_limits(width: int, height: int, bytes_needed: int) -> None:
-    """Raise BakeInputError when a width x height render exceeds the GPU's texture size or the
+    """Raise ViewInputError when a width x height render exceeds the GPU's texture size or the
     memory budget (checked before any texture is made)."""
-    from ..core.errors import BakeInputError
+    from ..core.errors import ViewInputError
     limit = gpu.capabilities.max_texture_size_get()
     if max(width, height) > limit:
-        raise BakeInputError(f"a {width}x{height} image exceeds this GPU's texture limit of {limit} pixels per side")
-    _check_budget(bytes_needed, f"a {width}x{height} render")
+        raise ViewInputError(f"a {width}x{height} image exceeds this GPU's texture limit of {limit} pixels per side")
+    _check_budget(bytes_needed, f"a {width}x{height} render", ViewInputError)
 
 
-def _check_budget(bytes_needed: int, what: str) -> None:
+def _check_budget(bytes_needed: int, what: str, error: type | None = None) -> None:
+    """Raise `error` (default BakeInputError) when bytes_needed is above the GPU memory budget."""
     from ..core.errors import BakeInputError
     budget = gpu_memory_budget()
     if bytes_needed > budget:
-        raise BakeInputError(f"{what} needs about {bytes_needed / 2**20:.0f} MiB of GPU memory, above the "
+        raise (error or BakeInputError)(f"{what} needs about {bytes_needed / 2**20:.0f} MiB of GPU memory, above the "
                              f"budget of {budget / 2**20:.0f} MiB (set HAO_GPU_MEMORY_BUDGET to raise it)")
 
 
@@ -141,14 +142,8 @@ def image_barrier() -> None:
     """Make image writes of earlier draws visible to later reads. gpu.compute.dispatch()
     issues GPU_memory_barrier(TEXTURE_FETCH | SHADER_IMAGE_ACCESS) after it runs; draws issue
     none, so a 1x1x1 dispatch of an empty kernel supplies the missing glMemoryBarrier."""
-    from .shaders import cached_shader
-
-    def build():
-        info = gpu.types.GPUShaderCreateInfo()
-        info.local_group_size(1, 1, 1)
-        info.compute_source("void main() {}")
-        return info
-    shader = cached_shader(("barrier",), build)
+    from .shaders import barrier_shader
+    shader = barrier_shader()
     gpu.compute.dispatch(shader, 1, 1, 1)
     gpu.shader.unbind()
 

@@ -5,7 +5,7 @@ A bake *needs* abilities (a max distance, Selected to Active, bent normals, UDIM
 colour attribute); each baker declares the ones it lacks and why. Everything that depended
 on a baker's reach comes from these rows: Auto's choice (``choose_method``), the refusal
 when a chosen method cannot bake what is asked (``check_method``), the methods factory's
-list (hao_addon/bakers.py), the README's table (tools/readme_tables.py) and the tests'
+list (hao_addon/bakers.py), the manual's table (tools/docs_pages.py) and the tests'
 backend lists (``bakers_with``). A new capability is a new row of ABILITIES, and the bakers
 that lack it say so in their ``cannot``.
 """

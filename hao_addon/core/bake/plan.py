@@ -20,7 +20,8 @@ from .abilities import abilities_needed, check_method, choose_method
 from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
-from .projection import HighToLow, RayCast, check_high_to_low, drain, projected_receivers_steps
+from ..steps import drain
+from .projection import HighToLow, RayCast, check_high_to_low, projected_receivers_steps
 from .receivers import Receivers, corner_receivers, uv_receivers
 from .settings import BakeSettings
 from .uv_checks import uv_layout_warnings

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import BakeInputError
 from ..geometry import TriangleSoup, corner_shading_normals, face_normals_areas, smooth_vertex_normals
+from ..steps import drain
 from .receivers import Receivers, interpolate_unit, tiled_sample_points
 from .udim import UdimLayout
 from .settings import BakeSettings
@@ -126,15 +127,6 @@ def ray_starts(target: TriangleSoup, request: HighToLow, face: np.ndarray, bary:
 RAYS_PER_STEP = 50_000
 
 
-def drain(steps: Generator) -> object:
-    """Run a *_steps generator to its end and return its value."""
-    while True:
-        try:
-            next(steps)
-        except StopIteration as stop:
-            return stop.value
-
-
 def project(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, max_ray_distance: float
             ) -> tuple[np.ndarray, np.ndarray]:
     """First hit of each ray on triangles (Fs, 3, 3) (both sides). Returns (face (m,) int64,
@@ -201,13 +193,6 @@ def barycentric_from_uv(uv: np.ndarray) -> np.ndarray:
 # a generator of progress fractions that returns (face, bary). bakers.ray_caster_for() gives
 # the GPU twin (gpu/bake_ray_cast.py) to the GPU bakers.
 RayCast = Callable[[np.ndarray, np.ndarray, np.ndarray, float], Generator[float, None, tuple[np.ndarray, np.ndarray]]]
-
-
-def projected_receivers(target: TriangleSoup, request: HighToLow, settings: BakeSettings, centre: np.ndarray,
-                        scale: float, cast: RayCast | None = None, tiles: UdimLayout | None = None
-                        ) -> tuple[Receivers, dict, str | None]:
-    """projected_receivers_steps() run to its end."""
-    return drain(projected_receivers_steps(target, request, settings, centre, scale, cast, tiles))
 
 
 def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,

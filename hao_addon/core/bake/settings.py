@@ -174,12 +174,6 @@ class BakeSettings:
         validate(self)
         return self
 
-    @property
-    def resolved_method(self) -> str:
-        """The bake variant that runs on the target's own surface: 'auto' picks by the max
-        distance (see method_for)."""
-        return self.method_for(high_to_low=False)
-
     def method_for(self, high_to_low: bool, tiled: bool = False) -> str:
         """The bake variant that runs: the Method, or for 'auto' the bakers' declared choice
         (core/bake/abilities.py: the scatter with a max distance where it can bake the rest

@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Automatic UV atlas with xatlas for meshes that have no UV map (CPU; no bpy).
+"""Automatic UV atlas for meshes that have no UV map (CPU; no bpy): planar charts
+(``charts.py``) packed by xatlas (``unwrap_worker.py``).
 
-Two things make xatlas safe to call on any mesh here:
+Two things make it safe to run on any mesh here:
 - scale: xatlas' epsilons are absolute, so a mesh of 1e10 units ran for minutes and one of
   1e-4 units packed nothing. It unwraps a copy centred and scaled to unit size; UVs do not
   depend on scale, so the real positions are never needed.
-- interrupts: xatlas holds the interpreter lock until it returns, so it runs in a child
-  process (``unwrap_worker.py``) that is killed at once on Ctrl-C, SIGTERM or Esc.
+- interrupts: xatlas holds the interpreter lock until it returns, so the unwrap runs in a
+  child process that is killed at once on Ctrl-C, SIGTERM or Esc.
 """
 from __future__ import annotations
 
@@ -22,11 +23,14 @@ from typing import Generator
 import numpy as np
 
 from ..errors import BakeInputError
+from ..steps import drain
 from .unwrap_worker import atlas_uvs
 
-# Texels kept free around each chart (>= 2 so the bake's one-texel tent and bilinear lookups
-# never mix charts).
-DEFAULT_PADDING = 4
+# xatlas' padding around each chart, in texels of the texture, on top of its one-texel
+# bilinear border and conservative rasterization: with 1, at least three texels lie clear
+# between two charts' covered texels (measured on the bunny at 256^2 and 1024^2; the tests
+# require two, so the bake's one-texel tent and bilinear lookups never mix charts).
+DEFAULT_PADDING = 1
 # A triangle whose area is below this fraction of the (unit) bounding box is treated as
 # degenerate when deciding whether anything can be unwrapped at all.
 MIN_RELATIVE_AREA = 1e-14
@@ -41,7 +45,7 @@ class UnwrapError(BakeInputError):
 def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -> np.ndarray:
     """(V, 3) float32: the vertices centred on their box and scaled so its longest side is 1.
 
-    Raises UnwrapError for meshes xatlas cannot unwrap: no triangles, non-finite or
+    Raises UnwrapError for meshes that cannot be unwrapped: no triangles, non-finite or
     out-of-range indices, or no triangle with area."""
     v = np.asarray(vertices, np.float64)
     t = np.asarray(triangles)
@@ -64,7 +68,7 @@ def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -
     return unit.astype(np.float32)
 
 
-def xatlas_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
+def unwrap_in_process(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
                   padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
     """Per-corner UVs (F, 3, 2) float64 in [0, 1], in this process (blocks until done).
 
@@ -88,7 +92,7 @@ def worker_python() -> str | None:
 
 def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
                  padding: int = DEFAULT_PADDING, name: str = "mesh") -> Generator[None, None, np.ndarray]:
-    """Like xatlas_unwrap, in a child process: yields while it runs (poll, report progress,
+    """Like unwrap_in_process, in a child process: yields while it runs (poll, report progress,
     or close the generator to kill it), returns the UVs (F, 3, 2).
 
     Closing the generator, or an exception in the caller while it is suspended (Ctrl-C),
@@ -97,7 +101,7 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
     python = worker_python()
     if python is None:
         yield
-        return xatlas_unwrap(unit, triangles, resolution, padding, name)
+        return unwrap_in_process(unit, triangles, resolution, padding, name)
     folder = tempfile.mkdtemp(prefix="hao-unwrap-")
     proc = None
     try:
@@ -125,11 +129,4 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
 def run_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
                padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
     """Blocking unwrap in a child process (interruptible); returns (F, 3, 2) UVs."""
-    steps = unwrap_steps(vertices, triangles, resolution, padding, name)
-    try:
-        while True:
-            next(steps)
-    except StopIteration as stop:
-        return stop.value
-    finally:
-        steps.close()
+    return drain(unwrap_steps(vertices, triangles, resolution, padding, name))
