@@ -212,8 +212,6 @@ def test_progress_on_a_terminal_and_not_when_quiet(dirs):
     assert proc.returncode == 0 and text == ""
 
 
-@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
-                                                (signal.SIGTERM, 143, "terminated")])
 def big_sphere_obj(path: Path, segments: int = 640, rings: int = 320) -> Path:
     """An indexed UV sphere without UVs (409,600 triangles at the defaults): an unwrap of
     seconds, long enough to be interrupted in (the bunny's takes under one)."""
@@ -234,6 +232,8 @@ def big_sphere_obj(path: Path, segments: int = 640, rings: int = 320) -> Path:
     return path
 
 
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
+                                                (signal.SIGTERM, 143, "terminated")])
 def test_signal_during_unwrap_stops_at_once(dirs, signum, code, word):
     out, tmp = dirs
     sphere = big_sphere_obj(tmp.parent / "big_sphere.obj")

@@ -99,6 +99,7 @@ def bunny_atlas():
     return v, np.asarray(t, np.int64), run_unwrap(v, t, 256)
 
 
+@pytest.mark.release_independent  # numpy and xatlas only: run on the newest release
 def test_the_bunny_atlas_covers_more_texels_than_xatlas_did_and_overlaps_nowhere(bunny_atlas):
     """Issue 32: texel coverage at least that of the xatlas atlas it replaces (measured by the
     unwrap benchmark at the same size), no texel centre in two triangles at twice the size."""
@@ -111,6 +112,7 @@ def test_the_bunny_atlas_covers_more_texels_than_xatlas_did_and_overlaps_nowhere
     assert overlapping_texels(uvs, 512) == 0
 
 
+@pytest.mark.release_independent  # numpy and xatlas only: run on the newest release
 def test_every_chart_is_a_flat_projection_packed_at_one_scale(bunny_atlas):
     """Each face's UV area is its surface area times the cosine to its chart's direction, at
     one texel density per chart, the same for the large charts (xatlas rounds a chart's size
@@ -174,6 +176,7 @@ def test_the_fast_overlap_check_equals_the_reference_rasterizer(seed):
     assert expected and set(overlapping_faces(uvs, size).tolist()) == expected
 
 
+@pytest.mark.release_independent  # numpy and xatlas only: run on the newest release
 def test_charts_keep_their_padding_in_texels_of_the_texture(bunny_atlas):
     """The atlas is packed into exactly the texture's size, so the padding is in its texels:
     no texel within two texels of one chart is covered by another (the bake's tent and
