@@ -109,8 +109,15 @@ def adjacent_faces(triangles: np.ndarray) -> np.ndarray:
 
 
 def connected_components(count: int, pairs: np.ndarray) -> np.ndarray:
-    """(count,) component index 0..C-1 of each node of an undirected graph (min-label
-    propagation with pointer jumping: a few dozen array passes even on long chains)."""
+    """(count,) component index 0..C-1 of each node of an undirected graph with edges
+    pairs (P, 2)."""
+    return np.unique(root_labels(count, pairs), return_inverse=True)[1].reshape(-1)
+
+
+def root_labels(count: int, pairs: np.ndarray) -> np.ndarray:
+    """(count,) the smallest node of each node's component, for edges pairs (P, 2): hooking
+    of roots plus pointer jumping, a few array passes even on long chains (6 for the
+    35k-vertex bunny's triangles)."""
     label = np.arange(count)
     while True:
         low = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
@@ -124,7 +131,7 @@ def connected_components(count: int, pairs: np.ndarray) -> np.ndarray:
                 break
             label = jumped
         if np.array_equal(label, before):
-            return np.unique(label, return_inverse=True)[1].reshape(-1)
+            return label
 
 
 def islands_of(face_direction: np.ndarray, pairs: np.ndarray) -> np.ndarray:
