@@ -34,13 +34,13 @@ def test_every_shader_variant_compiles(gpu_context):
     import hao_addon.gpu as gpu_package
     for info in pkgutil.iter_modules(gpu_package.__path__):
         importlib.import_module(f"hao_addon.gpu.{info.name}")  # each module registers its factories
-    for factory, domains in shaders.SHADER_FACTORIES:
-        variants = shaders.variant_arguments(factory, domains)
+    for factory, domains, valid in shaders.SHADER_FACTORIES:
+        variants = shaders.variant_arguments(domains, valid)
         assert variants, f"{factory.__name__} declares no valid variant"
         for arguments in variants:
             assert factory(**arguments) is not None, (factory.__name__, arguments)
     # A shader compiled outside a declared factory would escape this test.
-    declared = {factory.__qualname__ for factory, _ in shaders.SHADER_FACTORIES}
+    declared = {factory.__qualname__ for factory, _domains, _valid in shaders.SHADER_FACTORIES}
     for info in pkgutil.iter_modules(gpu_package.__path__):
         module = importlib.import_module(f"hao_addon.gpu.{info.name}")
         for name, function in inspect.getmembers(module, inspect.isfunction):

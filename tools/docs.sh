@@ -6,13 +6,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source tools/bpy_releases.sh
+# The default environment first: it installs the apt packages and finds the Python both use.
+venv="$(bash tools/setup.sh | tail -n 1)"
 py="$(find_python 3.13 2>/dev/null || command -v python3)"
 if [ ! -x .venv-docs/bin/mkdocs ] || ! cmp -s requirements/docs.txt .venv-docs/.requirements.installed; then
   "$py" -m venv .venv-docs
   .venv-docs/bin/python -m pip install -q --disable-pip-version-check -r requirements/docs.txt
   cp requirements/docs.txt .venv-docs/.requirements.installed
 fi
-venv="$(bash tools/setup.sh | tail -n 1)"
 "$venv/bin/python" tools/docs_pages.py --check
 NO_MKDOCS_2_WARNING=1 .venv-docs/bin/mkdocs build --strict --quiet
 echo "manual: $(pwd)/site/index.html"

@@ -97,8 +97,8 @@ def compile_with_log(info: "gpu.types.GPUShaderCreateInfo", label: str) -> "gpu.
 
 # Every shader factory, with the values each of its parameters takes (shader_variants):
 # the tests compile every variant from this list, not from a list of their own.
-SHADER_FACTORIES: list[tuple[Callable, dict[str, tuple]]] = []
-_VALID: dict[Callable, Callable[[dict], bool]] = {}
+# (factory, the values of each parameter, which combinations exist)
+SHADER_FACTORIES: list[tuple[Callable, dict[str, tuple], Callable[[dict], bool]]] = []
 # Up to this many variants a factory's parameters are combined in full; beyond it, each value
 # of each parameter once (beside the defaults) and all of them at their last value together.
 FULL_PRODUCT_LIMIT = 16
@@ -108,20 +108,17 @@ def shader_variants(valid: Callable[[dict], bool] | None = None, **domains: tupl
     """Declare a shader factory and the values each parameter takes (its variants); valid:
     which combinations exist (the terminator lift needs shading normals, say)."""
     def register(factory: Callable) -> Callable:
-        SHADER_FACTORIES.append((factory, domains))
-        if valid is not None:
-            _VALID[factory] = valid
+        SHADER_FACTORIES.append((factory, domains, valid or (lambda _arguments: True)))
         return factory
     return register
 
 
-def variant_arguments(factory: Callable, domains: dict[str, tuple]) -> list[dict]:
+def variant_arguments(domains: dict[str, tuple], valid: Callable[[dict], bool]) -> list[dict]:
     """The argument sets of a factory's variants to compile: all combinations up to
     FULL_PRODUCT_LIMIT, else every value of every parameter once (on the defaults where that
     combination exists, else on the first that does) and all parameters at their last value.
     Combinations the factory's `valid` rules out are left out."""
     import itertools
-    valid = _VALID.get(factory, lambda _arguments: True)
     names = list(domains)
     product = [dict(zip(names, values)) for values in itertools.product(*(domains[n] for n in names))]
     if len(product) <= FULL_PRODUCT_LIMIT:
