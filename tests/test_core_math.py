@@ -183,6 +183,26 @@ def test_analytic_formulas():
     assert np.all(scenes.wall_accessibility(x, 1.0, "wendland") >= scenes.wall_accessibility(x, 1.0, "none"))
 
 
+def test_finite_wall_form_factor_limits_and_quadrature():
+    """The finite wall's contour formula: an endless wall hides half the sky (1/2 at any
+    distance), a point in line with a half-endless wall's end sees a quarter hidden (3/4), a
+    far wall hides nothing, and points of a 4 x 2 wall match a midpoint quadrature of Malley's
+    disk (the cosine-weighted hemisphere; its own error is below 1e-4 at this grid)."""
+    np.testing.assert_allclose(scenes.finite_wall_accessibility([1e-3, 0.5, 3.0], 0.0, 1e9, 1e9), 0.5, atol=1e-6)
+    np.testing.assert_allclose(scenes.finite_wall_accessibility([0.5, 2.0], 0.5e9, 1e9, 1e9), 0.75, atol=1e-6)
+    assert scenes.finite_wall_accessibility([1e6], 0.0, 1.0, 1.0)[0] > 1.0 - 1e-9
+    x, lateral = np.array([0.05, 0.3, 1.0, 2.5, 0.7]), np.array([0.0, 0.4, -1.7, 0.9, 2.6])
+    grid = 1500
+    c = (np.arange(grid) + 0.5) / grid
+    a, b = np.meshgrid(2.0 * c - 1.0, c, indexing="xy")  # a: sideways, b: towards the wall
+    inside = a * a + b * b < 1.0
+    a, b = a[inside], b[inside]
+    up = np.sqrt(1.0 - a * a - b * b)
+    quadrature = [1.0 - ((np.abs(yi + a * xi / b) <= 2.0) & (up * xi / b <= 2.0)).sum() * 2.0 / grid ** 2 / np.pi
+                  for xi, yi in zip(x, lateral)]
+    np.testing.assert_allclose(scenes.finite_wall_accessibility(x, lateral, 4.0, 2.0), quadrature, atol=3e-4)
+
+
 def test_closed_surface_detection():
     from hao_addon.core.geometry import is_closed_surface
     from hao_addon.core import scenes

@@ -135,25 +135,31 @@ def wall_accessibility(distance_to_wall: np.ndarray, max_distance: float, fallof
     return 1.0 - (rho * chord).sum(axis=1) / quadrature / np.pi
 
 
-def finite_wall_accessibility(distance_to_wall: np.ndarray, lateral: np.ndarray, width: float, height: float,
-                              grid: int = 2000) -> np.ndarray:
-    """Floor points next to a finite wall (unlimited distance), by midpoint quadrature of
-    the Malley disk (error about 1/grid). The wall stands at distance x in front of the point,
-    spans |y - lateral| <= width / 2 sideways and 0 <= z <= height."""
+def finite_wall_accessibility(distance_to_wall: np.ndarray, lateral: np.ndarray, width: float,
+                              height: float) -> np.ndarray:
+    """(N,) accessibility of floor points next to a finite wall (unlimited distance), exactly.
+    The wall stands at distance x (N,) in front of the point, spans |y - lateral| <= width / 2
+    sideways and 0 <= z <= height.
+
+    With unlimited distance the occlusion is the wall's point-to-polygon form factor, given by
+    Lambert's contour formula: F = (1/2pi) |sum_i theta_i n . (v_i x v_i+1)/|v_i x v_i+1||
+    over the rectangle's edges, v_i its corners as seen from the point, theta_i the angle each
+    edge spans, n the floor's normal (exact for a polygon above the point's horizon, as the
+    wall is). The edge along the floor spans its angle in the horizon plane and counts whole."""
     x = np.atleast_1d(np.asarray(distance_to_wall, float))
     y0 = np.broadcast_to(np.asarray(lateral, float), x.shape)
-    c = (np.arange(grid) + 0.5) / grid
-    a, b = np.meshgrid(2.0 * c - 1.0, c, indexing="xy")  # a: sideways, b: towards the wall (> 0)
-    inside = a * a + b * b < 1.0
-    a, b = a[inside], b[inside]
-    up = np.sqrt(1.0 - a * a - b * b)
-    cell = (2.0 / grid) * (1.0 / grid)
-    out = np.empty_like(x)
-    for i, (xi, yi) in enumerate(zip(x, y0)):
-        t = xi / b
-        hit = (np.abs(yi + a * t) <= width / 2) & (up * t <= height)
-        out[i] = 1.0 - hit.sum() * cell / np.pi
-    return out
+    left, right = -width / 2 - y0, width / 2 - y0  # the wall's sides, relative to the point
+    zeros = np.zeros_like(x)
+    # Corners (N, 4, 3) in (sideways, forward, up), in order around the rectangle.
+    corners = np.stack([np.stack([left, x, zeros], -1), np.stack([right, x, zeros], -1),
+                        np.stack([right, x, zeros + height], -1), np.stack([left, x, zeros + height], -1)], 1)
+    v = corners / np.linalg.norm(corners, axis=-1, keepdims=True)
+    w = np.roll(v, -1, axis=1)
+    cross = np.cross(v, w)
+    sine = np.linalg.norm(cross, axis=-1)
+    theta = np.arctan2(sine, (v * w).sum(-1))
+    up = np.divide(cross[..., 2], sine, out=np.zeros_like(sine), where=sine > 0.0)
+    return 1.0 - np.abs((theta * up).sum(axis=1)) / (2.0 * np.pi)
 
 
 def sphere_on_plane_kernel_accessibility(rho: np.ndarray, radius: float, max_distance: float,
