@@ -129,10 +129,12 @@ def wall_accessibility(distance_to_wall: np.ndarray, max_distance: float, fallof
     if falloff == "none":
         s = np.clip(x / max_distance, 0.0, 1.0)
         return 1.0 - (np.arccos(s) - s * np.sqrt(1.0 - s * s)) / np.pi
+    # Once per distinct distance: a map's texels repeat a few distances many times.
+    distinct, index = np.unique(x, return_inverse=True)
     y = (np.arange(quadrature) + 0.5) / quadrature
     chord = 2.0 * np.sqrt(1.0 - y * y)
-    rho = occlusion_weight(x[:, None] / y[None, :], max_distance, falloff)
-    return 1.0 - (rho * chord).sum(axis=1) / quadrature / np.pi
+    rho = occlusion_weight(distinct[:, None] / y[None, :], max_distance, falloff)
+    return (1.0 - (rho * chord).sum(axis=1) / quadrature / np.pi)[index.reshape(x.shape)]
 
 
 def finite_wall_accessibility(distance_to_wall: np.ndarray, lateral: np.ndarray, width: float,
