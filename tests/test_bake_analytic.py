@@ -138,6 +138,29 @@ def test_reference_tracer_max_distance_and_backfaces():
     np.testing.assert_allclose(got, 1.0)
 
 
+def test_first_hits_casts_as_first_hit_does():
+    """The reference baker's loop over one direction (first_hits: one BVH cast a ray where no
+    rule skips a hit) gives first_hit's distances exactly, misses and reach included, with
+    and without back faces skipped and a min distance."""
+    from mathutils import Vector
+    from hao_addon.core.geometry import face_normals_areas
+    from hao_addon.core.reference import build_bvh, first_hit, first_hits
+    floor, wall = floor_and_wall(width=20.0, height=10.0)
+    scene = np.concatenate([floor.positions, wall.positions[:, ::-1]])  # the wall seen from behind
+    ray_cast = build_bvh(scene).ray_cast
+    rng = np.random.default_rng(5)
+    origins = [Vector(p) for p in np.stack([-rng.uniform(0.05, 2.0, 64), rng.uniform(-1, 1, 64), np.full(64, 1e-6)], 1)]
+    offsets = np.full(64, 1e-6)
+    direction = np.array([0.6, 0.0, 0.8])
+    for faces, min_distance, reach in ((None, 0.0, 1e30), (None, 0.0, 1.0), (face_normals_areas(scene)[0], 0.0, 1e30),
+                                       (None, 0.5, 1e30)):
+        one = [first_hit(ray_cast, o, direction, reach, 1e-6, faces, min_distance) for o in origins]
+        got = first_hits(ray_cast, origins, direction, reach, offsets, faces, min_distance)
+        np.testing.assert_array_equal(got, one)
+        assert np.isfinite(got).any() or faces is not None
+    assert np.isinf(first_hits(ray_cast, origins, direction, 1e30, offsets, face_normals_areas(scene)[0])).all()
+
+
 @pytest.mark.parametrize("directions", [256, 1024])
 def test_sigma_bound_catches_a_two_percent_normalization_error(gpu_context, directions):
     """The tolerance is not vacuous: the gather's map of the sphere on the plane passes it,

@@ -25,7 +25,7 @@ from .estimators import texel_sums
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from .terminator import lift_amount
-from ..reference import build_bvh, first_hit, hits_along, ray_offset
+from ..reference import build_bvh, first_hits, hits_along, ray_offset
 from .alpha import expected_visibility
 from .projection import barycentric
 
@@ -102,12 +102,13 @@ class ReferenceBaker:
         else:
             lifted = np.zeros(len(self.points), bool)
         d_max = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 0.0
-        starts = [(i, self.origins[i]) for i in np.flatnonzero(above & (weight > 0.0) & ~lifted)]
-        starts += [(i, Vector(self.points[i] + self.lift[i] * amount[i])) for i in np.flatnonzero(lifted)]
+        plain, lifted_at = np.flatnonzero(above & (weight > 0.0) & ~lifted), np.flatnonzero(lifted)
+        starts = [(i, self.origins[i]) for i in plain]
+        starts += [(i, Vector(self.points[i] + self.lift[i] * amount[i])) for i in lifted_at]
         if self.plan.alpha is None:
-            for i, origin in starts:
-                dists[i] = first_hit(ray_cast, origin, omega, reach, self.offsets[i], self.face_normals,
-                                     self.plan.min_distance_normalized)
+            rays = np.concatenate([plain, lifted_at])
+            dists[rays] = first_hits(ray_cast, [origin for _i, origin in starts], omega, reach, self.offsets[rays],
+                                     self.face_normals, self.plan.min_distance_normalized)
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)
         else:  # every surface up to the first opaque one, each kept with its alpha (core/bake/alpha.py)
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)  # 0 below the surface
