@@ -140,11 +140,12 @@ def test_reference_tracer_max_distance_and_backfaces():
 
 def test_first_hits_casts_as_first_hit_does():
     """The reference baker's loop over one direction (first_hits: one BVH cast a ray where no
-    rule skips a hit) gives first_hit's distances exactly, misses and reach included, with
-    and without back faces skipped and a min distance."""
+    rule skips a hit), and the viewport reference's over one point (first_hits_from), give
+    first_hit's distances exactly, misses and reach included, with and without back faces
+    skipped and a min distance."""
     from mathutils import Vector
     from hao_addon.core.geometry import face_normals_areas
-    from hao_addon.core.reference import build_bvh, first_hit, first_hits
+    from hao_addon.core.reference import build_bvh, first_hit, first_hits, first_hits_from
     floor, wall = floor_and_wall(width=20.0, height=10.0)
     scene = np.concatenate([floor.positions, wall.positions[:, ::-1]])  # the wall seen from behind
     ray_cast = build_bvh(scene).ray_cast
@@ -159,6 +160,15 @@ def test_first_hits_casts_as_first_hit_does():
         np.testing.assert_array_equal(got, one)
         assert np.isfinite(got).any() or faces is not None
     assert np.isinf(first_hits(ray_cast, origins, direction, 1e30, offsets, face_normals_areas(scene)[0])).all()
+    # The viewport reference's loop: one origin, many directions (first_hits_from).
+    directions = np.stack([rng.uniform(0.1, 1, 64), rng.uniform(-1, 1, 64), rng.uniform(0.05, 1, 64)], 1)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    near = Vector((-0.3, 0.0, 1e-6))  # within 1.0 of the wall along some of the directions
+    for faces, reach in ((None, 1e30), (None, 1.0), (face_normals_areas(scene)[0], 1e30)):
+        one = [first_hit(ray_cast, near, d, reach, 1e-6, faces) for d in directions]
+        got = first_hits_from(ray_cast, near, directions, reach, 1e-6, faces)
+        np.testing.assert_array_equal(got, one)
+        assert np.isfinite(got).any() or faces is not None
 
 
 @pytest.mark.parametrize("directions", [256, 1024])

@@ -75,6 +75,17 @@ def first_hits(ray_cast, origins: list[Vector], direction: np.ndarray, reach: fl
     return np.array([np.inf if d is None else d for d in dists], dtype=np.float64).reshape(len(origins))
 
 
+def first_hits_from(ray_cast, origin: Vector, directions: np.ndarray, reach: float, offset: float,
+                    face_normals: np.ndarray | None) -> np.ndarray:
+    """(n,) first_hit from one `origin` along each of `directions` (n, 3); without back faces
+    to skip each ray is one cast, made directly (the same distances)."""
+    if face_normals is not None:
+        return np.array([first_hit(ray_cast, origin, d, reach, offset, face_normals) for d in directions],
+                        dtype=np.float64).reshape(len(directions))
+    dists = [ray_cast(origin, Vector(d), reach)[3] for d in directions.tolist()]
+    return np.array([np.inf if d is None else d for d in dists], dtype=np.float64).reshape(len(directions))
+
+
 def hits_along(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
                face_normals: np.ndarray | None, opaque, limit: int = 256,
                min_distance: float = 0.0) -> list[tuple[float, int, np.ndarray]]:
@@ -137,7 +148,6 @@ def reference_accessibility(points: np.ndarray, normals: np.ndarray, triangles: 
         origin = Vector(points[i] + true_normals[i] * offset)
         above = world @ true_normals[i] > 0.0
         dists = np.zeros(len(world))  # below the true surface: occluded at once
-        for k in np.flatnonzero(above):
-            dists[k] = first_hit(ray_cast, origin, world[k], reach, offset, face_n)
+        dists[above] = first_hits_from(ray_cast, origin, world[above], reach, offset, face_n)
         out[i] = 1.0 - occlusion_weight(dists, max_distance, falloff).mean()
     return out
