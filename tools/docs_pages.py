@@ -139,30 +139,31 @@ def bench_description(stem: str) -> str:
     return " ".join(head.split()) + "\n\n" + ("Run: `" + "`, `".join(usage) + "`.\n\n" if usage else "") + prose
 
 
-def flat_rows(value, prefix: str = "") -> list[tuple[str, str]]:
-    """(key path, value) of a JSON value's scalars and short lists, for a two-column table."""
+def json_values(value, prefix: str = ""):
+    """(key path, value) of every value inside a JSON value that is not an object, objects
+    walked into."""
     if isinstance(value, dict):
-        out = []
         for key, item in value.items():
-            out += flat_rows(item, f"{prefix}.{key}" if prefix else str(key))
-        return out
-    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
-        return []  # rendered as its own table
-    if isinstance(value, list):
-        return [(prefix, ", ".join(_fmt(v) for v in value[:12]) + (" ..." if len(value) > 12 else ""))]
-    return [(prefix, _fmt(value))]
+            yield from json_values(item, f"{prefix}.{key}" if prefix else str(key))
+    else:
+        yield prefix, value
+
+
+def _is_records(value) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
+
+
+def flat_rows(value, prefix: str = "") -> list[tuple[str, str]]:
+    """(key path, value) of a JSON value's scalars and short lists, for a two-column table
+    (lists of records are tables of their own: record_tables)."""
+    return [(path, ", ".join(_fmt(v) for v in item[:12]) + (" ..." if len(item) > 12 else "")
+             if isinstance(item, list) else _fmt(item))
+            for path, item in json_values(value, prefix) if not _is_records(item)]
 
 
 def record_tables(value, prefix: str = "") -> list[tuple[str, list[dict]]]:
     """Every list of records (dicts) inside a JSON value, with its key path."""
-    if isinstance(value, dict):
-        out = []
-        for key, item in value.items():
-            out += record_tables(item, f"{prefix}.{key}" if prefix else str(key))
-        return out
-    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
-        return [(prefix, value)]
-    return []
+    return [(path, item) for path, item in json_values(value, prefix) if _is_records(item)]
 
 
 def _fmt(v) -> str:

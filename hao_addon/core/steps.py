@@ -25,13 +25,11 @@ def relay(steps: Generator, each: Callable[[Any], Any] = lambda step: step) -> G
 
 def drain(steps: Generator, progress: Callable[[Any], None] | None = None) -> Any:
     """Run `steps` to its end, calling progress(step) for each step; returns its value."""
+    relayed = relay(steps, progress or (lambda step: None))
     try:
         while True:
-            try:
-                step = next(steps)
-            except StopIteration as stop:
-                return stop.value
-            if progress is not None:
-                progress(step)
+            next(relayed)
+    except StopIteration as stop:
+        return stop.value
     finally:
-        steps.close()
+        relayed.close()  # closes steps too
