@@ -69,10 +69,9 @@ def first_hits(ray_cast, origins: list[Vector], direction: np.ndarray, reach: fl
     mostly this loop's)."""
     dv = Vector(direction)
     if face_normals is not None or min_distance > 0.0:
-        return np.array([first_hit(ray_cast, o, direction, reach, offset, face_normals, min_distance, dv)
-                         for o, offset in zip(origins, offsets)], dtype=np.float64).reshape(len(origins))
-    dists = [ray_cast(o, dv, reach)[3] for o in origins]
-    return np.array([np.inf if d is None else d for d in dists], dtype=np.float64).reshape(len(origins))
+        return _distances([first_hit(ray_cast, o, direction, reach, offset, face_normals, min_distance, dv)
+                           for o, offset in zip(origins, offsets)])
+    return _distances([ray_cast(o, dv, reach)[3] for o in origins])
 
 
 def first_hits_from(ray_cast, origin: Vector, directions: np.ndarray, reach: float, offset: float,
@@ -80,10 +79,13 @@ def first_hits_from(ray_cast, origin: Vector, directions: np.ndarray, reach: flo
     """(n,) first_hit from one `origin` along each of `directions` (n, 3); without back faces
     to skip each ray is one cast, made directly (the same distances)."""
     if face_normals is not None:
-        return np.array([first_hit(ray_cast, origin, d, reach, offset, face_normals) for d in directions],
-                        dtype=np.float64).reshape(len(directions))
-    dists = [ray_cast(origin, Vector(d), reach)[3] for d in directions.tolist()]
-    return np.array([np.inf if d is None else d for d in dists], dtype=np.float64).reshape(len(directions))
+        return _distances([first_hit(ray_cast, origin, d, reach, offset, face_normals) for d in directions])
+    return _distances([ray_cast(origin, Vector(d), reach)[3] for d in directions.tolist()])
+
+
+def _distances(dists: list) -> np.ndarray:
+    """(n,) float64 of hit distances, a miss (None from the BVH) as inf."""
+    return np.array([np.inf if d is None else d for d in dists], dtype=np.float64).reshape(len(dists))
 
 
 def hits_along(ray_cast, origin: Vector, direction: np.ndarray, reach: float, offset: float,
