@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import select_only, small_settings, soup_to_object
+from conftest import DATA, select_only, small_settings, soup_to_object
 from hao_addon.core import scenes
 from hao_addon.gpu.util import live_pass_count, snapshot_state
 
@@ -55,9 +55,88 @@ def test_mesh_without_uvs_gets_ao_uv_from_xatlas(scene):
     assert [l.name for l in obj.data.uv_layers] == ["AO_UV"]
     uv = uv_array(obj.data, "AO_UV").reshape(-1, 2)
     assert uv.min() >= 0 and uv.max() <= 1 and np.ptp(uv, axis=0).min() > 0.5
+    assert written_overlap(obj, "AO_UV", 128) == 0  # issue 38: a quad per chart, not half of one
     # A second bake reuses AO_UV instead of unwrapping again.
     bpy.ops.object.hao_bake_ao()
     assert [l.name for l in obj.data.uv_layers] == ["AO_UV"]
+
+
+def written_overlap(obj, uv_name: str, size: int) -> int:
+    """Texel centres of a size^2 map inside two triangles of the UV map as Blender stores
+    it (per polygon corner): what a bake into it writes twice."""
+    from hao_addon.blender.mesh_data import base_mesh_triangles, written_triangle_uvs
+    from hao_addon.core.bake.charts import overlapping_texels
+    _co, _tris, loops, _polygons = base_mesh_triangles(obj)
+    return overlapping_texels(written_triangle_uvs(obj.data, uv_name, loops), size)[0]
+
+
+def _subdivided(obj, levels=1):
+    modifier = obj.modifiers.new("Subdivision", 'SUBSURF')
+    modifier.levels = levels
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.modifier_apply(modifier=modifier.name)
+    return obj
+
+
+def _without_uvs(obj):
+    while obj.data.uv_layers:
+        obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    return obj
+
+
+def _added(op, **kw):
+    op(**kw)
+    return bpy.context.active_object
+
+
+def _imported(path):
+    before = set(bpy.data.objects)
+    if path.suffix == ".glb":
+        bpy.ops.import_scene.gltf(filepath=str(path))
+    else:
+        bpy.ops.wm.obj_import(filepath=str(path))
+    return max((o for o in bpy.data.objects if o not in before and o.type == 'MESH'), key=lambda o: len(o.data.polygons))
+
+
+# Meshes as Blender users have them, without UVs (issue 38): quads, quads subdivided,
+# n-gons (a cylinder's caps), a skinned character and a CAD part.
+UNWRAP_MESHES = {
+    "suzanne-quads": lambda: _added(bpy.ops.mesh.primitive_monkey_add),
+    "suzanne-subdivided": lambda: _subdivided(_added(bpy.ops.mesh.primitive_monkey_add)),
+    "cube-subdivided": lambda: _subdivided(_added(bpy.ops.mesh.primitive_cube_add), 2),
+    "cylinder-ngons": lambda: _added(bpy.ops.mesh.primitive_cylinder_add, vertices=24),
+    "cesium-man": lambda: _imported(DATA / "CesiumMan.glb"),
+    "fandisk": lambda: _imported(DATA / "fandisk.obj"),
+}
+
+
+@pytest.mark.parametrize("name", UNWRAP_MESHES)
+def test_auto_unwrap_writes_uvs_that_overlap_nowhere(scene, name):
+    """Measured on the UV map as written (per polygon corner) at texel centres: 0 texels
+    written twice. Before, a quad's two triangles could land in two charts: Suzanne
+    overlapped on half its texels, with exit 0."""
+    obj = _without_uvs(UNWRAP_MESHES[name]())
+    select_only(obj)
+    small_settings(scene, uv_mode='AUTO', size=256, directions=8)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert "AO_UV" in obj.data.uv_layers
+    assert written_overlap(obj, "AO_UV", 256) == 0
+
+
+def test_overlapping_written_uvs_fail_the_bake_and_leave_no_uv_map(scene, monkeypatch, addon):
+    """The rule behind it: a map the tool itself sees is wrong is a failure. Triangles
+    unwrapped one by one (the old way) overlap on Suzanne: the bake stops, nothing stays."""
+    import sys
+    bake_job = sys.modules[f"{addon.__name__}.hao_addon.blender.bake_job"]  # the operator's copy
+    real = bake_job.unwrap_steps
+    monkeypatch.setattr(bake_job, "unwrap_steps", lambda *a, polygons=None, **kw: real(*a, **kw))
+    obj = _without_uvs(_added(bpy.ops.mesh.primitive_monkey_add))
+    select_only(obj)
+    small_settings(scene, uv_mode='AUTO', size=256, directions=8)
+    images = set(bpy.data.images.keys())
+    with pytest.raises(RuntimeError, match=r"the automatic UVs of 'Suzanne' overlap on \d+ of \d+ texels"):
+        bpy.ops.object.hao_bake_ao()
+    assert len(obj.data.uv_layers) == 0 and set(bpy.data.images.keys()) == images
 
 
 def test_named_uv_map_missing_is_a_clear_error(scene):

@@ -38,7 +38,7 @@ from ..core.bake.targets import BakeTarget
 from ..core.bake.texture_set import texture_set_target
 from ..core.bake.udim import tile_path, udim_layout
 from ..core.geometry import TriangleSoup, face_normals_areas
-from ..core.bake.unwrap import unwrap_steps
+from ..core.bake.unwrap import check_unwrap_overlap, unwrap_steps
 from . import color_attributes, images, mesh_data
 from .material_channels import roughness_metallic
 from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
@@ -409,13 +409,15 @@ class BakeJob:
             return mesh_data.AO_UV_NAME  # ours from an earlier bake: reuse, never re-unwrap
         if mesh.uv_layers:
             return mesh.uv_layers[0].name  # AUTO: the first UV map when there is one
-        positions, tris, tri_loops = mesh_data.base_mesh_triangles(obj)
-        unwrap = unwrap_steps(positions, tris, self.request.settings.size, name=obj.name)
+        positions, tris, tri_loops, polygons = mesh_data.base_mesh_triangles(obj)
+        size = self.request.settings.size
+        unwrap = unwrap_steps(positions, tris, size, name=obj.name, polygons=polygons)
         t0 = time.perf_counter()
         uvs = yield from _with_status(unwrap, 0.0, f"Unwrapping '{obj.name}'")
         self.unwrap_seconds += time.perf_counter() - t0
         new_name = mesh_data.add_uv_layer(mesh, mesh_data.AO_UV_NAME, tri_loops, uvs)
-        self.created_uv.append((mesh, new_name))
+        self.created_uv.append((mesh, new_name))  # removed again if the bake fails
+        check_unwrap_overlap(mesh_data.written_triangle_uvs(mesh, new_name, tri_loops), size, obj.name)
         return new_name
 
     def _occluder_objects(self, target) -> list:

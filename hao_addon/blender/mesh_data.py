@@ -231,16 +231,21 @@ def color_attribute_target(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph
         obj_eval.to_mesh_clear()
 
 
-def base_mesh_triangles(obj: bpy.types.Object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Original (unevaluated) mesh: (positions (V, 3), triangles (F, 3), triangle loops (F, 3))."""
-    return _mesh_arrays(obj.data)
+def base_mesh_triangles(obj: bpy.types.Object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Original (unevaluated) mesh: (positions (V, 3), triangles (F, 3), triangle loops (F, 3),
+    each triangle's polygon (F,))."""
+    co, tri_verts, tri_loops = _mesh_arrays(obj.data)
+    polygons = np.empty(len(obj.data.loop_triangles), dtype=np.int64)
+    obj.data.loop_triangles.foreach_get("polygon_index", polygons)
+    return co, tri_verts, tri_loops, polygons
 
 
 def add_uv_layer(mesh: bpy.types.Mesh, name: str, tri_loops: np.ndarray, corner_uvs: np.ndarray) -> str:
     """Create a new UV map from per-triangle-corner UVs (F, 3, 2); returns its actual name.
 
-    Loops shared by two triangles of one n-gon receive the UV of the later triangle; xatlas
-    keeps the triangles of a planar polygon in one chart, where the two agree.
+    Loops shared by two triangles of one polygon receive the UV of the later triangle: the
+    unwrap keeps a polygon's triangles in one chart (core/bake/charts.py), where the two
+    agree; written_overlap measures what was written.
     The new map does not become the active one, so existing UV workflows are untouched.
     """
     active = mesh.uv_layers.active_index if len(mesh.uv_layers) else -1
@@ -253,3 +258,8 @@ def add_uv_layer(mesh: bpy.types.Mesh, name: str, tri_loops: np.ndarray, corner_
     if active >= 0:
         mesh.uv_layers.active_index = active
     return layer.name
+
+
+def written_triangle_uvs(mesh: bpy.types.Mesh, name: str, tri_loops: np.ndarray) -> np.ndarray:
+    """(F, 3, 2): the named UV map as a bake reads it, per triangle corner (from the loops)."""
+    return loop_uvs(mesh, name)[tri_loops]

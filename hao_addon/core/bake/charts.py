@@ -15,6 +15,12 @@ facing one way (a spiral ramp). ``overlapping_faces`` finds that on the packed a
 ``split_islands`` cuts such islands in two at their median height along the projection
 direction, until nothing overlaps (at the last resort every such face is its own chart).
 
+Charts are made of whole polygons: given each triangle's polygon (a quad's two triangles, an
+n-gon's fan), every step (direction, absorption, splits) decides per polygon, so the
+corners a polygon's triangles share get one UV. Blender stores UVs per polygon corner: a
+quad split across two charts would write one of them over the other (Suzanne without UVs
+overlapped on half its texels that way).
+
 This file imports only numpy: the unwrap's child process loads it by file name.
 """
 from __future__ import annotations
@@ -204,29 +210,58 @@ def welded_corners(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndar
     return vertices[triangles].astype(np.float64), index.reshape(-1)[triangles]
 
 
-def projection_charts(vertices: np.ndarray, triangles: np.ndarray, angle_limit_deg: float = ANGLE_LIMIT_DEG
-                      ) -> Charts:
-    """Planar charts of the mesh: vertices (V, 3) of about unit size, triangles (F, 3)."""
+def polygon_leaders(polygons: np.ndarray | None, count: int) -> np.ndarray:
+    """(F,) for each triangle the first triangle of its polygon (polygons: (F,) polygon
+    index of each triangle, or None: every triangle is its own polygon). A per-triangle
+    label indexed by this is one label per polygon."""
+    if polygons is None:
+        return np.arange(count)
+    polygons = np.asarray(polygons, np.int64)
+    _unique, first, inverse = np.unique(polygons, return_index=True, return_inverse=True)
+    return first[inverse.reshape(-1)]
+
+
+def polygon_normals(normals: np.ndarray, areas: np.ndarray, leader: np.ndarray) -> np.ndarray:
+    """(F, 3): each triangle's polygon's area-weighted unit normal (a non-planar quad's two
+    triangles see one normal, so they choose one direction)."""
+    sums = np.zeros_like(normals)
+    np.add.at(sums, leader, normals * areas[:, None])
+    length = np.linalg.norm(sums, axis=1)
+    unit = np.where(length[:, None] > 0, sums / np.maximum(length, 1e-300)[:, None], normals)
+    return unit[leader]
+
+
+def projection_charts(vertices: np.ndarray, triangles: np.ndarray, angle_limit_deg: float = ANGLE_LIMIT_DEG,
+                      polygons: np.ndarray | None = None) -> Charts:
+    """Planar charts of the mesh: vertices (V, 3) of about unit size, triangles (F, 3),
+    polygons (F,) each triangle's polygon (None: triangles are the polygons)."""
     corners, triangles = welded_corners(vertices, triangles)
     normals, areas = normals_and_areas(corners)
+    leader = polygon_leaders(polygons, len(triangles))
+    normals = polygon_normals(normals, areas, leader)
     directions = projection_directions(normals, areas, angle_limit_deg)
     pairs = adjacent_faces(triangles)
     face_direction = absorb_small_islands(normals, np.argmax(normals @ directions.T, axis=1), pairs, directions)
+    face_direction = face_direction[leader]  # absorption looked at neighbours per triangle
     return _charts(corners, triangles, directions, face_direction, islands_of(face_direction, pairs))
 
 
 def split_islands(charts: Charts, vertices: np.ndarray, triangles: np.ndarray, which: np.ndarray,
-                  alone: bool = False) -> Charts:
+                  alone: bool = False, polygons: np.ndarray | None = None) -> Charts:
     """The charts with each island in `which` cut in two at its median height along its
-    direction (then split into edge-connected pieces); alone: its faces become one chart
-    each instead."""
+    direction (then split into edge-connected pieces); alone: its polygons become one chart
+    each instead. A polygon's triangles stay together (polygons as projection_charts')."""
     corners, triangles = welded_corners(vertices, triangles)
     island = charts.island.copy()
+    leader = polygon_leaders(polygons, len(island))
     chosen = np.isin(island, which)
     if alone:
-        part = np.where(chosen, np.arange(len(island)), -1)
+        part = np.where(chosen, leader, -1)
     else:
         height = np.einsum("fj,fj->f", corners.mean(axis=1), charts.direction[charts.face_direction])
+        sums = np.zeros(len(island))
+        np.add.at(sums, leader, height)
+        height = sums[leader] / np.bincount(leader, minlength=len(island))[leader]  # the polygon's mean
         median = np.zeros(charts.count)
         for i in np.unique(island[chosen]):
             median[i] = np.median(height[island == i])
@@ -241,11 +276,27 @@ def split_islands(charts: Charts, vertices: np.ndarray, triangles: np.ndarray, w
 def overlapping_faces(uvs: np.ndarray, size: int) -> np.ndarray:
     """Indices of the faces whose UV triangles (F, 3, 2) in [0, 1] share a texel centre of
     a size x size grid with another face (strictly inside both: shared edges do not count)."""
-    p = uvs * size - 0.5  # texel-centre coordinates
+    pixel, face = texel_hits(uvs, size)
+    twice = np.bincount(pixel, minlength=size * size)[pixel] > 1
+    return np.unique(face[twice])
+
+
+def overlapping_texels(uvs: np.ndarray, size: int) -> tuple[int, int]:
+    """(texel centres strictly inside two or more UV triangles, texel centres covered) of a
+    size x size grid: the overlap a bake into these UVs would write twice."""
+    pixel, _face = texel_hits(uvs, size)
+    counts = np.bincount(pixel, minlength=size * size)
+    return int((counts > 1).sum()), int((counts > 0).sum())
+
+
+def texel_hits(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """(pixel, face): one entry per texel centre strictly inside a UV triangle (F, 3, 2) of
+    a size x size grid (pixel = y * size + x); vectorized by the triangles' texel span."""
+    p = np.asarray(uvs, np.float64) * size - 0.5  # texel-centre coordinates
     lo = np.floor(p.min(axis=1)).astype(np.int64) + 1
     hi = np.floor(p.max(axis=1)).astype(np.int64)
     span = np.maximum(hi - lo + 1, 0)
-    pixel_parts, face_parts = [], []
+    pixel_parts, face_parts = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
     for side in np.unique(np.maximum(span[:, 0], span[:, 1])):
         if side == 0:
             continue
@@ -264,8 +315,4 @@ def overlapping_faces(uvs: np.ndarray, size: int) -> np.ndarray:
             inside &= (xs >= 0) & (xs < size) & (ys >= 0) & (ys < size)
             pixel_parts.append((ys * size + xs)[inside])
             face_parts.append(np.broadcast_to(f[:, None], inside.shape)[inside])
-    if not pixel_parts:
-        return np.zeros(0, np.int64)
-    pixel, face = np.concatenate(pixel_parts), np.concatenate(face_parts)
-    twice = np.bincount(pixel, minlength=size * size)[pixel] > 1
-    return np.unique(face[twice])
+    return np.concatenate(pixel_parts), np.concatenate(face_parts)

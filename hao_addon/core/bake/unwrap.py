@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import BakeInputError
 from ..steps import drain
+from .charts import overlapping_texels
 from .unwrap_worker import atlas_uvs
 
 # xatlas' padding around each chart, in texels of the texture, on top of its one-texel
@@ -40,6 +41,19 @@ WORKER = Path(__file__).with_name("unwrap_worker.py")
 
 class UnwrapError(BakeInputError):
     """The mesh cannot be unwrapped; the message says why."""
+
+
+def check_unwrap_overlap(written: np.ndarray, size: int, name: str = "mesh") -> int:
+    """Raise UnwrapError when the UVs as written (F, 3, 2: what a bake reads back) put a
+    texel centre of the size x size map inside two triangles: such a map would be wrong,
+    so it is a failure, never a warning. Returns the texels covered."""
+    overlap, covered = overlapping_texels(written, size)
+    if overlap:
+        raise UnwrapError(f"the automatic UVs of '{name}' overlap on {overlap} of {covered} texels "
+                          f"({100.0 * overlap / max(covered, 1):.2g} %): nothing was baked; give it a UV map")
+    if not covered:
+        raise UnwrapError(f"the automatic UVs of '{name}' cover no texel of a {size}^2 map")
+    return covered
 
 
 def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -> np.ndarray:
@@ -69,14 +83,16 @@ def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -
 
 
 def unwrap_in_process(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
-                  padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
+                      padding: int = DEFAULT_PADDING, name: str = "mesh",
+                      polygons: np.ndarray | None = None) -> np.ndarray:
     """Per-corner UVs (F, 3, 2) float64 in [0, 1], in this process (blocks until done).
 
     vertices: (V, 3) float, any scale and offset; triangles: (F, 3) int vertex indices;
-    resolution: the texture size the atlas is packed for."""
+    resolution: the texture size the atlas is packed for; polygons: (F,) each triangle's
+    polygon (a polygon's triangles land in one chart) or None."""
     unit = unit_copy(vertices, triangles, name)
     try:
-        return atlas_uvs(unit, np.asarray(triangles, np.uint32), resolution, padding)
+        return atlas_uvs(unit, np.asarray(triangles, np.uint32), resolution, padding, polygons)
     except RuntimeError as exc:
         raise UnwrapError(f"cannot unwrap '{name}': {exc}") from None
 
@@ -91,7 +107,8 @@ def worker_python() -> str | None:
 
 
 def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
-                 padding: int = DEFAULT_PADDING, name: str = "mesh") -> Generator[None, None, np.ndarray]:
+                 padding: int = DEFAULT_PADDING, name: str = "mesh",
+                 polygons: np.ndarray | None = None) -> Generator[None, None, np.ndarray]:
     """Like unwrap_in_process, in a child process: yields while it runs (poll, report progress,
     or close the generator to kill it), returns the UVs (F, 3, 2).
 
@@ -101,13 +118,14 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
     python = worker_python()
     if python is None:
         yield
-        return unwrap_in_process(unit, triangles, resolution, padding, name)
+        return unwrap_in_process(unit, triangles, resolution, padding, name, polygons)
     folder = tempfile.mkdtemp(prefix="hao-unwrap-")
     proc = None
     try:
         source, target = os.path.join(folder, "in.npz"), os.path.join(folder, "out.npy")
+        extra = {} if polygons is None else {"polygons": np.asarray(polygons, np.int64)}
         np.savez(source, vertices=unit, triangles=np.asarray(triangles, np.uint32),
-                 resolution=np.int64(resolution), padding=np.int64(padding))
+                 resolution=np.int64(resolution), padding=np.int64(padding), **extra)
         env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
         with open(os.path.join(folder, "err.txt"), "wb") as err:
             proc = subprocess.Popen([python, str(WORKER), source, target], stdin=subprocess.DEVNULL,
@@ -127,6 +145,6 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
 
 
 def run_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
-               padding: int = DEFAULT_PADDING, name: str = "mesh") -> np.ndarray:
+               padding: int = DEFAULT_PADDING, name: str = "mesh", polygons: np.ndarray | None = None) -> np.ndarray:
     """Blocking unwrap in a child process (interruptible); returns (F, 3, 2) UVs."""
-    return drain(unwrap_steps(vertices, triangles, resolution, padding, name))
+    return drain(unwrap_steps(vertices, triangles, resolution, padding, name, polygons))

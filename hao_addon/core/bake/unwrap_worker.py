@@ -99,12 +99,14 @@ def placed_charts(charts: Charts, packed: np.ndarray) -> np.ndarray:
     return out
 
 
-def atlas_uvs(vertices: np.ndarray, triangles: np.ndarray, resolution: int, padding: int) -> np.ndarray:
+def atlas_uvs(vertices: np.ndarray, triangles: np.ndarray, resolution: int, padding: int,
+              polygons: np.ndarray | None = None) -> np.ndarray:
     """Per-corner UVs (F, 3, 2) float64 in [0, 1] of an atlas of planar charts packed for
     `resolution` texels with `padding` free texels around each chart, no two faces sharing
     a point. vertices (V, 3) float32 should be of unit size near the origin (xatlas' epsilons
-    are absolute); triangles (F, 3) uint32. Raises RuntimeError when packing fails."""
-    charts = projection_charts(vertices, triangles)
+    are absolute); triangles (F, 3) uint32; polygons (F,) each triangle's polygon (its
+    triangles stay in one chart) or None. Raises RuntimeError when packing fails."""
+    charts = projection_charts(vertices, triangles, polygons=polygons)
     for round_ in range(SPLIT_ROUNDS + 1):
         uvs = pack_charts(charts, resolution, padding)
         overlapping = overlapping_faces(uvs, CHECK_SCALE * int(resolution))
@@ -113,7 +115,7 @@ def atlas_uvs(vertices: np.ndarray, triangles: np.ndarray, resolution: int, padd
         if round_ == SPLIT_ROUNDS:
             break
         charts = split_islands(charts, vertices, triangles, np.unique(charts.island[overlapping]),
-                               alone=round_ == SPLIT_ROUNDS - 1)
+                               alone=round_ == SPLIT_ROUNDS - 1, polygons=polygons)
     raise RuntimeError(f"{len(overlapping)} faces still overlap after {SPLIT_ROUNDS} splits")
 
 
@@ -123,7 +125,9 @@ def main(argv: list[str]) -> int:
     source, target = argv
     try:
         with np.load(source) as data:
-            uvs = atlas_uvs(data["vertices"], data["triangles"], int(data["resolution"]), int(data["padding"]))
+            polygons = data["polygons"] if "polygons" in data.files else None
+            uvs = atlas_uvs(data["vertices"], data["triangles"], int(data["resolution"]), int(data["padding"]),
+                            polygons)
         with open(target, "wb") as fh:
             np.save(fh, uvs)
     except Exception as exc:  # reported by the parent as one line
