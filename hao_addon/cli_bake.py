@@ -33,7 +33,7 @@ class _Run:
     mesh_out: Path | None  # a colour bake's mesh file
     reads: list[tuple[str, str]]
     writes: list[tuple[str, str]]
-    key: str  # the run's bake key (cli_skip.run_key)
+    key: str  # the run's bake key (cli_skip.run_key), once the scene is loaded (_scene_key)
 
     @property
     def to_colors(self) -> bool:
@@ -52,6 +52,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         progress.update("loading")
         load_scene(run.source)
     check_signals()
+    run.key = _scene_key(args, run)
     groups = _pick_groups(args, run, report) if run.options.match_names else None
     if groups is not None:
         targets, high_poly, cage = [low for group in groups for low in group.lows], None, None
@@ -77,7 +78,6 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 def _checked_run(args, report: Report) -> _Run:
     """The settings, and every file the run reads and writes, checked before a long load."""
     from .blender.paths import example_path
-    from .cli_skip import run_key
     from .core.bake.job_options import JobOptions
     from .core.bake.settings import BakeSettings
     from .core.imageio import check_writable
@@ -118,8 +118,17 @@ def _checked_run(args, report: Report) -> _Run:
     reads, writes = _bake_files(args, source, mesh_out, gltf_out)
     literal = [(path, what) for path, what in image_outputs(args, to_colors) if not has_token(path)]
     check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
-    key = run_key(args, [Path(path) for path, _what in reads])
-    return _Run(settings, options, source, frames, gltf_out, mesh_out, reads, writes, key)
+    return _Run(settings, options, source, frames, gltf_out, mesh_out, reads, writes, key="")
+
+
+def _scene_key(args, run: _Run) -> str:
+    """The run's bake key once the scene is loaded: its texture files count as inputs (an
+    alpha texture edited on disk makes the maps stale)."""
+    from .blender.images import scene_image_files
+    from .cli_skip import run_key
+    files = [Path(path) for path, _what in run.reads]
+    files += [Path(path) for path, _what in scene_image_files() if os.path.isfile(path)]
+    return run_key(args, files)
 
 
 def _fill_map_outputs(args) -> None:

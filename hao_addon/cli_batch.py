@@ -15,6 +15,39 @@ from .core.folders import nearest_existing, unmakeable_reason
 from .core.output_files import check_output_files, INPUT_TOKEN, OBJECT_TOKEN
 
 
+# The output options a batch resolves against --out-dir when they are relative (a farm task
+# runs in a scratch folder that its farm deletes afterwards: nothing may land there).
+BATCH_FILE_OPTIONS = ("bent_normal_out", "thickness_out", "orm_out", "error_out", "gltf_out")
+
+
+def batch_plan(args, folder: Path, template: str) -> tuple[list[argparse.Namespace], list[tuple[str, str]]]:
+    """(each input's own options: --out and the extra outputs filled and in `folder`; the
+    files the batch reads), every input's files checked against every other's and the
+    inputs before anything is baked: two inputs named alike in different folders ('a/x.obj',
+    'b/x.obj') or names that clean to one ('b c', 'b_c') would write one file. Names from
+    {object} are checked per input, against what the inputs before it wrote (batch_outputs)."""
+    if INPUT_TOKEN not in template and OBJECT_TOKEN not in template and len(args.input) > 1:
+        raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
+    subs = []
+    for path in args.input:
+        sub = argparse.Namespace(**vars(args))
+        sub.out = str(folder / template)
+        fill_input_token(sub, path)
+        for option in BATCH_FILE_OPTIONS:
+            value = getattr(sub, option, "")
+            if value and not os.path.isabs(value):
+                setattr(sub, option, str(folder / value))
+        sub.input = path
+        subs.append(sub)
+    reads = [(os.path.abspath(path), f"input '{path}'") for path in args.input]
+    planned = [(args.json or "", REPORT)]
+    for sub in subs:
+        planned += [(p, f"{what} of input '{sub.input}'") for p, what in image_outputs(sub, to_colors(sub))
+                    + [(sub.gltf_out or "", GLTF_OUT)] if not has_token(p)]
+    check_output_files(planned, reads)
+    return subs, reads
+
+
 def run_batch(args, report: Report, progress: Progress) -> list[str]:
     """Bake every input in this process (the GPU context, compiled shaders and caches carry
     over), each into --out-dir; a failed input is reported and the next one baked. A signal
@@ -28,25 +61,8 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     template = args.out or BATCH_NAME
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
-    if INPUT_TOKEN not in template and OBJECT_TOKEN not in template and len(args.input) > 1:
-        raise CLIError(f"--out '{template}' would write every input's map to the same file: put {INPUT_TOKEN} in it")
     from .gpu.shaders import cached_shader_count
-    subs = []
-    for path in args.input:
-        sub = argparse.Namespace(**vars(args))
-        sub.out = str(folder / template)
-        fill_input_token(sub, path)
-        sub.input = path
-        subs.append(sub)
-    # Every input's files at once, before any bake: two inputs named alike in different folders
-    # ('a/x.obj', 'b/x.obj') would write one file. Names from {object} are checked per input,
-    # against what the inputs before it wrote (batch_outputs).
-    reads = [(os.path.abspath(path), f"input '{path}'") for path in args.input]
-    planned = [(args.json or "", REPORT)]
-    for sub in subs:
-        planned += [(p, f"{what} of input '{sub.input}'") for p, what in image_outputs(sub, to_colors(sub))
-                    + [(sub.gltf_out or "", GLTF_OUT)] if not has_token(p)]
-    check_output_files(planned, reads)
+    subs, reads = batch_plan(args, folder, template)
     lines, written = [], []
     for index, sub in enumerate(subs):
         path = sub.input

@@ -26,7 +26,8 @@ from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
 from ..core.steps import relay
 from ..core.bake.error_estimate import estimate
 from ..verify import verify_steps
-from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
+from ..core.imageio import (BAKE_KEY, FORMATS, StagedFiles, check_writable, image_is_whole, output_is_whole,
+                            read_text)
 from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
@@ -261,8 +262,9 @@ def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple
 
 def finished_files(request: BakeRequest, key: str, frame: int | None = None) -> list[str] | None:
     """The files of the request (of one frame of a sequence) when every one exists and is
-    current: an image carries key as its BAKE_KEY (a map on UDIM tiles: every tile file
-    that exists does, and one at least), another file (glTF, mesh) is not empty. None when
+    current: an image carries key as its BAKE_KEY and decodes in full (a map on UDIM tiles:
+    every tile file that exists does, and one at least), another file (glTF, mesh) is whole
+    (output_is_whole). None when
     anything is missing or was made otherwise: the bake must run."""
     one = replace(request, frames=None if frame is None else [frame])
     done = []
@@ -270,12 +272,12 @@ def finished_files(request: BakeRequest, key: str, frame: int | None = None) -> 
         if not path or path == "-":
             continue
         if os.path.splitext(path)[1].lower() not in FORMATS:
-            if not (os.path.isfile(path) and os.path.getsize(path) > 0):
+            if not output_is_whole(path):
                 return None
             done.append(path)
             continue
         files = [path] if os.path.isfile(path) else sorted(glob.glob(_tile_glob(path)))
-        if not files or any(read_text(f, BAKE_KEY) != key for f in files):
+        if not files or any(read_text(f, BAKE_KEY) != key or not image_is_whole(f) for f in files):
             return None
         done += files
     return done
@@ -288,11 +290,13 @@ def _tile_glob(path: str) -> str:
 
 
 def input_files(request: BakeRequest) -> list[tuple[str, str]]:
-    """The files the run reads, as (path, what): the scene's file and the caller's extra_inputs."""
+    """The files the run reads, as (path, what): the scene's file, the image files its
+    materials read, and the caller's extra_inputs."""
+    from .images import scene_image_files
     source = [(request.source_path, "the input file")] if request.source_path else []
     if bpy.data.filepath:
         source.append((bpy.data.filepath, "the open .blend file"))
-    return source + [tuple(entry) for entry in request.extra_inputs]
+    return source + scene_image_files() + [tuple(entry) for entry in request.extra_inputs]
 
 
 def _validate_frames(request: BakeRequest) -> None:

@@ -205,3 +205,25 @@ def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: s
         tree.links.new(tex.outputs["Color"], b_in)
         tree.links.new(mix.outputs[2], base)
     return mat
+
+
+# Image sources whose pixels come from a file on disk.
+FILE_SOURCES = frozenset({'FILE', 'SEQUENCE', 'TILED', 'MOVIE'})
+
+
+def scene_image_files() -> list[tuple[str, str]]:
+    """The image files the open scene reads (alpha, roughness, metallic, any texture), as
+    (absolute path, what) for the output check and the --skip-existing key: a bake must not
+    write over a texture its materials read, and an edited texture makes its maps stale.
+    Packed images live in the .blend (already an input); a file hao baked itself (its bake
+    key in the metadata) is an output of an earlier bake, free to bake again."""
+    from ..core.imageio import BAKE_KEY, read_text
+    out = []
+    for image in bpy.data.images:
+        if image.source not in FILE_SOURCES or not image.filepath or image.packed_file is not None:
+            continue
+        path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
+        if os.path.isfile(path) and read_text(path, BAKE_KEY) is not None:
+            continue
+        out.append((path, f"the image '{image.name}' that the scene's materials read"))
+    return out
