@@ -30,9 +30,11 @@ from .core.output_files import OutputCollision
 def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
     """`bake`: one input with --out, or a batch (--out-dir, or several inputs), or a farm
     task's chunk of a manifest (--manifest, --chunk)."""
+    from .cli_farm import check_chunk_without_manifest, take_manifest_chunk
     if args.manifest:
-        from .cli_farm import take_manifest_chunk
         take_manifest_chunk(args)
+    else:
+        check_chunk_without_manifest(args)
     if not args.input:
         raise CLIError("bake needs an INPUT file (or --manifest FILE)")
     if args.frames:

@@ -82,7 +82,7 @@ def _checked_run(args, report: Report) -> _Run:
     from .core.bake.settings import BakeSettings
     from .core.imageio import check_writable
 
-    _fill_map_outputs(args)
+    fill_map_outputs(args)
     settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
     options = validated(settings_from_args(args, JobOptions), JobOptions)
     source = check_input(Path(args.input), INPUT_FORMATS)
@@ -131,7 +131,7 @@ def _scene_key(args, run: _Run) -> str:
     return run_key(args, files)
 
 
-def _fill_map_outputs(args) -> None:
+def fill_map_outputs(args) -> None:
     """--maps: each map without its own output option is written beside --out, named after
     it with _MAP before the extension."""
     from .cli_parser import MAP_OUTPUTS

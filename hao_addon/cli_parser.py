@@ -37,7 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--manifest", default=None, metavar="FILE",
                    help="a farm task: bake chunk --chunk of this job manifest (written by 'farm'), its inputs "
                         "relative to --input-root (default: the manifest's root), into --out-dir")
-    b.add_argument("--chunk", type=int, default=0, help="with --manifest: the chunk to bake (0 is the first)")
+    b.add_argument("--chunk", type=int, default=None, help="with --manifest: the chunk to bake (0 is the first)")
     b.add_argument("--input-root", default=None, metavar="DIR", help="with --manifest: the folder of its inputs")
     b.add_argument("--progress", choices=("terminal", "openjd"), default="terminal",
                    help="terminal: a progress line on a terminal; openjd: 'openjd_progress: P' lines on stdout "

@@ -400,7 +400,7 @@ CASES = [
     ("task-manifest-without-out-dir", [BAKE, "--manifest", "{in}/manifest.json"], 2,
      "--manifest needs --out-dir DIR"),
     ("verify-outputs-missing", [FARM, "verify", "--manifest", "{in}/manifest.json", "--out-dir", "{out}"], 1,
-     "1 of 1 expected outputs are missing or empty: spot_ao.png"),
+     "1 of 1 expected outputs are missing, empty or broken: spot_ao.png"),
 ]
 
 

@@ -45,6 +45,11 @@ def run_task(bundle: Path, step: str, cwd: Path, *extra) -> subprocess.Completed
                    "--step", step, *extra], cwd)
 
 
+def maps(folder: Path) -> list[str]:
+    """The files of an output folder, without the tasks' receipts (.hao-job)."""
+    return sorted(n for n in os.listdir(folder) if n != ".hao-job")
+
+
 def digests(folder: Path) -> dict[str, str]:
     return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir()) if p.is_file()}
 
@@ -83,18 +88,19 @@ def test_openjd_tasks_equal_a_local_batch_and_fail_only_for_their_own_inputs(job
     first, second = (run_task(bundle, "Bake", tmp_path, "-tp", f"Chunk={k}") for k in (0, 1))
     assert first.returncode != 0 and "broken.obj" in first.stdout and second.returncode == 0, second.stdout
     assert "openjd_progress: 100.0" in second.stdout
-    assert sorted(os.listdir(out)) == ["a_ao.png", "b_ao.png", "c_ao.png"]  # nothing of the broken one
+    assert sorted(n for n in os.listdir(out) if n != ".hao-job") == ["a_ao.png", "b_ao.png", "c_ao.png"]  # nothing of the broken one
     batch = hao(["bake", *[f for f in files if f.name != "broken.obj"], "--out-dir", local, *BAKE], tmp_path)
     assert batch.returncode == 0, batch.stderr
     assert digests(out) == digests(local)  # bit for bit what a workstation bakes
     # Re-run (a re-queued task): nothing baked again, no byte changed.
-    before = {p: p.stat().st_mtime_ns for p in out.iterdir()}
+    before = {p: p.stat().st_mtime_ns for p in out.iterdir() if p.is_file()}
     again = run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=1")
     assert again.returncode == 0 and "skipped 'b'" in again.stdout and "skipped 'c'" in again.stdout
-    assert {p: p.stat().st_mtime_ns for p in out.iterdir()} == before and digests(out) == digests(local)
+    assert {p: p.stat().st_mtime_ns for p in out.iterdir() if p.is_file()} == before
+    assert digests(out) == digests(local)
     # Verify: fails while the broken input has no map, naming it; and after a deletion.
     verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
-    assert verify.returncode != 0 and "1 of 4 expected outputs are missing or empty: broken_ao.png" in verify.stdout
+    assert verify.returncode != 0 and "1 of 4 expected outputs are missing, empty or broken: broken_ao.png" in verify.stdout
 
 
 def test_verify_names_a_deleted_output_and_passes_when_all_exist(job_inputs, tmp_path):
@@ -106,7 +112,7 @@ def test_verify_names_a_deleted_output_and_passes_when_all_exist(job_inputs, tmp
     assert run_task(bundle, "Verify", tmp_path, "--no-run-dependencies").returncode == 0
     (out / "b_ao.png").unlink()
     verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
-    assert verify.returncode != 0 and "1 of 2 expected outputs are missing or empty: b_ao.png" in verify.stdout
+    assert verify.returncode != 0 and "1 of 2 expected outputs are missing, empty or broken: b_ao.png" in verify.stdout
 
 
 def test_a_frame_range_in_chunks_equals_the_single_process_sequence(tmp_path):
@@ -138,7 +144,7 @@ def test_path_mapping_rewrites_the_roots(job_inputs, tmp_path):
     assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode != 0  # the old root is gone
     done = run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0", "--path-mapping-rules", json.dumps(rules))
     assert done.returncode == 0, done.stdout
-    assert os.listdir(out) == ["a_ao.png"]
+    assert maps(out) == ["a_ao.png"]
 
 
 def test_every_bake_option_reaches_each_task_unchanged(tmp_path):
@@ -150,10 +156,10 @@ def test_every_bake_option_reaches_each_task_unchanged(tmp_path):
     write_bundle("openjd", [SPOT], tmp_path / "out", tmp_path / "b", tmp_path, *options)
     template = json.loads((tmp_path / "b" / "template.json").read_text())
     args = template["steps"][0]["script"]["actions"]["onRun"]["args"]
-    assert args[:args.index("--skip-existing")] == ["-m", "hao_addon", "bake", "--manifest", "{{Param.Manifest}}",
-                                                    "--chunk", "{{Task.Param.Chunk}}", "--input-root",
-                                                    "{{Param.InputRoot}}", "--out-dir", "{{Param.OutputDir}}"]
-    forwarded = args[args.index("openjd") + 1:]
+    assert args[:args.index("--skip-existing")] == ["-m", "hao_addon", "bake", "--manifest={{Param.Manifest}}",
+                                                    "--chunk={{Task.Param.Chunk}}", "--input-root={{Param.InputRoot}}",
+                                                    "--out-dir={{Param.OutputDir}}"]
+    forwarded = args[args.index("--progress=openjd") + 2:]  # after the receipt (--json)
     from hao_addon.cli_parser import build_parser
     parse = build_parser().parse_args
     given = vars(parse(["bake", str(SPOT), *options]))
@@ -226,7 +232,7 @@ def test_an_opencue_line_runs_as_written(job_inputs, tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     done = subprocess.run(first, shell=True, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert os.listdir(out) == ["a_ao.png"]
+    assert maps(out) == ["a_ao.png"]
 
 
 def test_a_bundle_of_1500_inputs_is_valid(tmp_path):
@@ -365,6 +371,134 @@ def test_the_blender_runner_calls_the_extensions_command_with_the_same_bake(job_
     run = subprocess.run([sys.executable, "-c", BLENDER_COMMAND, str(ROOT), json.dumps(args)], capture_output=True,
                          text=True, env=env, cwd=tmp_path, timeout=300)
     assert run.returncode == 0, run.stderr
-    assert os.listdir(out) == ["a_ao.png"] and "openjd_progress: 100.0" in run.stdout
+    assert maps(out) == ["a_ao.png"] and "openjd_progress: 100.0" in run.stdout
     local = hao(["bake", job_inputs / "a.obj", "--out", tmp_path / "a_ao.png", *BAKE], tmp_path)
     assert local.returncode == 0 and (tmp_path / "a_ao.png").read_bytes() == (out / "a_ao.png").read_bytes()
+
+
+# -- issue 38: hostile names, collisions, every output checked ------------------------------------
+
+# One folder name holding what shells, OpenJD's and Flamenco's parsers treat specially: a
+# command substitution, backticks, ';' and '&', both quotes, a leading '-', unicode, OpenJD's
+# '{{ }}' and a Flamenco placeholder. A newline is refused (below).
+HOSTILE = "-x $(touch PWNED1) `touch PWNED2` ; touch PWNED3 & 'q' \"d\" ünï 漢 {{Param.OutputDir}} {chunk}"
+
+
+def _hostile_job(tmp_path: Path, kind: str) -> tuple[Path, Path, Path]:
+    folder = tmp_path / "in" / HOSTILE
+    folder.mkdir(parents=True)
+    (folder / "a.obj").write_bytes(SPOT.read_bytes())
+    out, bundle = tmp_path / ("out " + HOSTILE), tmp_path / "job"
+    write_bundle(kind, [folder / "a.obj"], out, bundle, tmp_path, *BAKE, "--thickness-out",
+                 "{input}_thick {x}.png")
+    return folder, out, bundle
+
+
+def _nothing_ran(tmp_path: Path) -> None:
+    assert not [p for p in tmp_path.rglob("PWNED*")] and not list(Path.cwd().glob("PWNED*"))
+
+
+def _job_done(out: Path) -> None:
+    assert maps(out) == ["a_ao.png", "a_thick {x}.png"]
+
+
+def test_hostile_names_run_as_data_under_openjd(tmp_path):
+    _folder, out, bundle = _hostile_job(tmp_path, "openjd")
+    assert openjd(["check", bundle / "template.json"], tmp_path).returncode == 0
+    bake = run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0")
+    assert bake.returncode == 0, bake.stdout[-2000:]
+    assert run_task(bundle, "Verify", tmp_path, "--no-run-dependencies").returncode == 0
+    _job_done(out)
+    _nothing_ran(tmp_path)
+
+
+def test_hostile_names_run_as_data_in_opencue_lines_through_a_shell(tmp_path):
+    _folder, out, bundle = _hostile_job(tmp_path, "opencue")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    lines = (bundle / "hao_commands.txt").read_text().splitlines()
+    assert len(lines) == 2  # a bake and the verify: nothing split a line
+    for line in lines:
+        done = subprocess.run(line, shell=True, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+    _job_done(out)
+    _nothing_ran(tmp_path)
+
+
+def test_hostile_names_run_as_data_in_the_flamenco_job_type(tmp_path):
+    folder, out, bundle = _hostile_job(tmp_path, "flamenco")
+    settings = json.loads((bundle / "job.json").read_text())["settings"]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    for task in flamenco_tasks(bundle / "hao_bake.js", settings):
+        for command in task["commands"]:  # Flamenco's exec: the program and its arguments, no shell
+            args = [command["params"]["exe"], *command["params"]["args"]]
+            assert f"--input-root={folder}" in args or task["name"] == "verify"
+            done = subprocess.run(args, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+            assert done.returncode == 0, done.stderr[-2000:]
+    _job_done(out)
+    _nothing_ran(tmp_path)
+
+
+@pytest.mark.parametrize("kind", ["openjd", "flamenco", "opencue"])
+def test_a_newline_in_a_path_is_refused_by_every_format(tmp_path, kind):
+    folder = tmp_path / "in\ntouch PWNED"
+    folder.mkdir()
+    (folder / "a.obj").write_bytes(SPOT.read_bytes())
+    done = hao(["farm", kind, folder / "a.obj", "--out-dir", tmp_path / "out", "--bundle", tmp_path / "job"],
+               tmp_path)
+    assert done.returncode == 2 and "contains a control character (a newline)" in done.stderr
+    assert not (tmp_path / "job").exists() and not (tmp_path / "out").exists()
+
+
+def test_verify_wants_every_map_of_every_input_whole(job_inputs, tmp_path):
+    """Every --maps kind and extra output, by its exact name; a truncated map or a folder in
+    a map's place fails; an {object} name of one input never stands for another's."""
+    files = [job_inputs / "a.obj", job_inputs / "b.obj"]
+    out, bundle = tmp_path / "out", tmp_path / "bundle"
+    write_bundle("openjd", files, out, bundle, tmp_path, "--chunk-size", "5", "--maps", "ao,thickness,error",
+                 "--out", "{input}_{object}.png", "--gltf-out", "{input}.glb", *BAKE)
+    assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode == 0
+    expected = ["a.glb", "a_a.png", "a_a_error.png", "a_a_thickness.png",  # {object}: the OBJ's mesh 'a'
+                "b.glb", "b_b.png", "b_b_error.png", "b_b_thickness.png"]
+    assert maps(out) == expected
+    assert run_task(bundle, "Verify", tmp_path, "--no-run-dependencies").returncode == 0
+    thickness = out / "b_b_thickness.png"
+    whole = thickness.read_bytes()
+    for damage in ("cut", "folder", "deleted"):
+        if thickness.is_file():
+            thickness.unlink()
+        if damage == "cut":
+            thickness.write_bytes(whole[:len(whole) // 2])
+        elif damage == "folder":
+            thickness.mkdir()
+        verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+        assert verify.returncode != 0 and "1 of 8 expected outputs are missing, empty or broken: " \
+            "b_{object}_thickness.png" in verify.stdout, (damage, verify.stdout[-1500:])
+        if damage == "folder":
+            thickness.rmdir()
+    thickness.write_bytes(whole)
+    (out / "a.glb").write_bytes((out / "a.glb").read_bytes()[:100])
+    verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+    assert verify.returncode != 0 and "expected outputs are missing, empty or broken: a.glb" in verify.stdout
+
+
+def test_a_truncated_map_is_baked_again_by_skip_existing(tmp_path):
+    """Its key sits in the header that survives the cut: the file must decode in full."""
+    out = tmp_path / "a.png"
+    args = ["bake", SPOT, "--out", out, "--skip-existing", *BAKE]
+    assert hao(args, tmp_path).returncode == 0
+    whole = out.read_bytes()
+    out.write_bytes(whole[:len(whole) - 20])
+    again = hao(args, tmp_path)
+    assert again.returncode == 0 and "skipped" not in again.stdout and out.read_bytes() == whole
+
+
+def test_a_killed_tasks_temporary_files_are_removed_by_its_next_run(tmp_path):
+    from hao_addon.core.imageio import temporary_prefix
+    out = tmp_path / "out"
+    out.mkdir()
+    stale = out / f"{temporary_prefix(out / 'spot_ao.png')}abc123.part"
+    stale.write_bytes(b"half a map")
+    other = out / ".hao-00000000-zzz.part"  # another file's: not this task's to remove
+    other.write_bytes(b"x")
+    assert hao(["bake", SPOT, "--out-dir", out, *BAKE], tmp_path).returncode == 0
+    assert not stale.exists() and other.exists()

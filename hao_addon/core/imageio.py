@@ -100,12 +100,43 @@ def _can_create_in(folder: Path) -> bool:
     return True
 
 
+def temporary_prefix(path: Path) -> str:
+    """The prefix of a target's temporary files: short (the target's own name can already be
+    at the length limit) and the target's own, so a later write of it finds what a killed
+    run left."""
+    return f"{TEMP_PREFIX}{hashlib.blake2b(Path(path).name.encode(), digest_size=4).hexdigest()}-"
+
+
+def remove_stale_temporaries(path: Path) -> int:
+    """Remove the temporary files a killed earlier write of this target left beside it
+    (.part, and .bak backups of a commit that never finished); returns how many. Only one
+    run writes a given file (every run's outputs are checked for collisions first)."""
+    removed = 0
+    prefix = temporary_prefix(path)
+    try:
+        names = os.listdir(path.parent)
+    except OSError:
+        return 0
+    for name in names:
+        if name.startswith(prefix) and name.endswith((".part", ".bak")):
+            try:
+                os.unlink(path.parent / name)
+                removed += 1
+            except OSError:
+                pass
+    return removed
+
+
+def _temporary_for(path: Path) -> tuple[int, str]:
+    remove_stale_temporaries(path)
+    return tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".part", dir=path.parent)
+
+
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write data to path through a temporary file in the same folder, renamed into place."""
     path = Path(path)
     made = make_folders(path.parent)
-    # A short temporary name: the target's own name can already be at the length limit.
-    fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
+    fd, tmp = _temporary_for(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -140,7 +171,7 @@ class StagedFiles:
     def write_bytes(self, path: str | Path, data: bytes) -> None:
         path = Path(path)
         self._made += make_folders(path.parent)
-        fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=".part", dir=path.parent)
+        fd, tmp = _temporary_for(path)
         self._staged.append((path, tmp))  # first: removed by discard() even if the write fails
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -159,7 +190,7 @@ class StagedFiles:
                 target, tmp = self._staged[0]
                 backup = None
                 if target.exists():
-                    backup = tempfile.mktemp(prefix=TEMP_PREFIX, suffix=".bak", dir=target.parent)
+                    backup = tempfile.mktemp(prefix=temporary_prefix(target), suffix=".bak", dir=target.parent)
                     os.link(target, backup)  # the earlier file stays reachable until release()
                 self._placed.append((target, backup))
                 self._staged.pop(0)

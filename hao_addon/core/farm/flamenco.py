@@ -30,9 +30,15 @@ def _with_env(runner: str, args: list[str]) -> list[str]:
     return ["env", "PYTHONPATH={addon}", *args] if runner == "python" else args
 
 
+def literal(text: str) -> str:
+    """text as the script's command templates hold it: braces doubled, so a '{' in a path or
+    option stays itself instead of reading as one of the job's placeholders."""
+    return text.replace("{", "{{").replace("}", "}}")
+
+
 def job_type_script(manifest: Manifest, runner: str, bake_options: list[str], name: str, version: str) -> str:
     """The job compiler script (JavaScript) of this job's manifest and options."""
-    bake = _with_env(runner, bake_task(runner, _placeholders("{chunk}"), bake_options))
+    bake = _with_env(runner, bake_task(runner, _placeholders("{chunk}"), [literal(o) for o in bake_options]))
     verify = _with_env(runner, verify_task(runner, _placeholders("")))
     settings = [{"key": key, "type": "string", "required": key != "addon" or runner == "python",
                  **({"subtype": "dir_path"} if key in ("input_root", "out_dir", "addon") else
@@ -52,9 +58,11 @@ const JOB_TYPE = {{
     settings: {json.dumps(settings)},
 }};
 
-// A command list with the job's settings (and the chunk) in place of the placeholders.
+// A command list with the job's settings (and the chunk) in place of the placeholders;
+// '{{{{' and '}}}}' stand for a literal brace (a path or an option may hold one).
 function haoArgs(template, settings, chunk) {{
-    return template.map((arg) => arg.replace(/\\{{(\\w+)\\}}/g, (whole, key) =>
+    return template.map((arg) => arg.replace(/\\{{\\{{|\\}}\\}}|\\{{(\\w+)\\}}/g, (whole, key) =>
+        whole === "{{{{" ? "{{" : whole === "}}}}" ? "}}" :
         key === "chunk" ? String(chunk) : (key in settings ? String(settings[key]) : whole)));
 }}
 

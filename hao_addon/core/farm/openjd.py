@@ -6,7 +6,7 @@ parameter values as ``openjd run --job-param file://`` takes them). JSON, not YA
 has no PyYAML, and OpenJD reads either.
 
 Step Bake has one task per chunk of the manifest (an INT range, so any number of chunks);
-step Verify, after it, fails naming any expected output that is missing or empty. The
+step Verify, after it, fails naming any expected output that is missing, empty or broken. The
 paths are PATH job parameters (input root IN, output folder OUT, manifest IN, executable),
 so a farm's path mapping rewrites them.
 """

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .manifest import RECEIPTS
+
 # How a worker runs hao: the executable's arguments before hao's own.
 RUNNERS = {
     "blender": ("-b", "-c", "hao"),  # a Blender with the extension installed (blender -b -c hao bake ...)
@@ -30,13 +32,17 @@ class TaskValues:
 
 def bake_task(runner: str, values: TaskValues, bake_options: list[str]) -> list[str]:
     """[executable, arguments...] of one chunk's bake: only what is missing is baked
-    (--skip-existing), so a re-queued task redoes just that."""
-    return [values.executable, *RUNNERS[runner], "bake", "--manifest", values.manifest, "--chunk", values.chunk,
-            "--input-root", values.input_root, "--out-dir", values.out_dir, "--skip-existing",
-            "--progress", PROGRESS_FORMAT, *bake_options]
+    (--skip-existing), so a re-queued task redoes just that. Its report (--json) is the
+    task's receipt in the output folder (manifest.RECEIPTS): the files it wrote for each
+    input, which Verify checks. Values as '--option=value': a path that starts with '-'
+    stays a value."""
+    return [values.executable, *RUNNERS[runner], "bake", f"--manifest={values.manifest}", f"--chunk={values.chunk}",
+            f"--input-root={values.input_root}", f"--out-dir={values.out_dir}", "--skip-existing",
+            f"--progress={PROGRESS_FORMAT}", f"--json={values.out_dir}/{RECEIPTS}/chunk-{values.chunk}.json",
+            *bake_options]
 
 
 def verify_task(runner: str, values: TaskValues) -> list[str]:
-    """[executable, arguments...] of the check that every expected output exists."""
-    return [values.executable, *RUNNERS[runner], "farm", "verify", "--manifest", values.manifest,
-            "--out-dir", values.out_dir]
+    """[executable, arguments...] of the check that every expected output exists and is whole."""
+    return [values.executable, *RUNNERS[runner], "farm", "verify", f"--manifest={values.manifest}",
+            f"--out-dir={values.out_dir}"]
