@@ -9,6 +9,7 @@ Nothing here touches Blender data: input and output are numpy.
 from __future__ import annotations
 
 import hashlib
+import math
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field, replace
@@ -133,6 +134,8 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
     """
     t0 = time.perf_counter()
+    if settings.spread_cos > 0.0 and settings.directions * math.sin(math.radians(settings.spread_angle)) ** 2 < 1.0:
+        raise BakeInputError("spread angle: " + spread_warning(settings, settings.directions).replace("the map is", "the map would be"))
     target = as_bake_target(target, settings.target, high_to_low, vertex_target)
     key = bake_key(target, occluders, settings) if use_cache else None
     if key is not None and key in _CACHE:
@@ -150,11 +153,34 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
             result = yield from _bake_uncached(target, occluders, settings)
     result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
                         target_name=target.name)
+    directions = result.error.directions if result.error is not None else settings.directions
+    sparse = spread_warning(settings, directions)
+    if sparse:
+        result.stats["warnings"] = [*result.stats.get("warnings", []), f"'{target.name}': {sparse}"]
     if key is not None:
         _CACHE[key] = result
         while len(_CACHE) > _CACHE_SIZE:
             _CACHE.popitem(last=False)
     return result
+
+
+# Fewer directions than this expected inside the spread cone make a map of noise (or, with
+# none inside, a white one): the bake says so.
+MIN_DIRECTIONS_IN_CONE = 16
+
+
+def spread_warning(settings: BakeSettings, directions: int) -> str:
+    """'' or a warning when the spread cone holds too few of the bake's directions: of
+    cosine-weighted directions a share sin^2(angle) falls within the cone."""
+    if settings.spread_cos <= 0.0:
+        return ""
+    share = math.sin(math.radians(settings.spread_angle)) ** 2
+    expected = directions * share
+    if expected >= MIN_DIRECTIONS_IN_CONE:
+        return ""
+    return (f"about {expected:.3g} of its {directions} directions fall within the spread angle of "
+            f"{settings.spread_angle:g} degrees: the map is {'white' if expected < 1 else 'mostly noise'}; "
+            f"raise the spread angle or Directions (about {MIN_DIRECTIONS_IN_CONE / share:.3g})")
 
 
 def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
@@ -344,7 +370,11 @@ def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: boo
     method = choose_method(settings.method, needs)
     check_method(method, needs)
     inside = replace(inside, method=method)
-    result = yield from bake_steps(inverted(target), [], inside, use_cache)
+    # About the true (flat) inverted surface: with shading normals, directions below a face
+    # but inside the smooth hemisphere count as occluded at distance 0 (Cycles' AO convention:
+    # the ray enters the surface), which for thickness is the ray leaving the mesh; they gave
+    # thickness up to 0.47 within a distance of 1e-30.
+    result = yield from bake_steps(inverted(replace(target, normals=None)), [], inside, use_cache)
     stats = {**result.stats, "thickness_distance": distance}
     twin = None if result.twin is None else -result.twin  # 1 - ao errs by minus ao's error
     return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles, twin, result.error)

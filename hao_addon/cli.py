@@ -112,9 +112,17 @@ def main(argv: list[str] | None = None) -> int:
                 args.json = None  # its file is an input or another output: leave it alone
         report.exit_code = code
         report.timings["total"] = round(time.perf_counter() - started, 4)
-        if args is not None and args.json:
+        if args is not None and args.json and not _makes_folders_for_nothing(args, report):
             _write_report(report, args.json, io)
         return code
+
+
+def _makes_folders_for_nothing(args, report: Report) -> bool:
+    """Whether the report is a farm task's receipt of a run that wrote nothing, into a folder
+    that does not exist: a failed task leaves no folder behind (its error is on stderr)."""
+    if not getattr(args, "manifest", None) or report.exit_code == 0 or report.outputs or args.json == "-":
+        return False
+    return not os.path.isdir(os.path.dirname(os.path.abspath(args.json)))
 
 
 def _write_report(report: Report, target: str, io: ProcessOutput) -> None:

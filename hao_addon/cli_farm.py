@@ -225,7 +225,7 @@ def _check_job_text(farm: str, manifest: Manifest, options: list[str], values: d
 def take_manifest_chunk(args) -> None:
     """A farm task's bake: its chunk's inputs (under --input-root, else the manifest's
     root), the manifest's output name, the chunk's frames; --out-dir is required (made
-    if missing)."""
+    when a file is written)."""
     from .cli_errors import CLIError
     if args.input:
         raise CLIError("--manifest names the inputs: give no INPUT besides it")
@@ -242,11 +242,7 @@ def take_manifest_chunk(args) -> None:
     args.input = [os.path.join(root, *entry.split("/")) for entry in manifest.chunk_inputs(args.chunk)]
     args.out = manifest.out
     args.frames = manifest.chunk_frames(args.chunk) or None
-    # The job's output folder may not exist yet on a worker (tasks race to make it: exist_ok).
-    try:
-        os.makedirs(args.out_dir, exist_ok=True)
-    except OSError as exc:
-        raise CLIError(f"cannot make the output folder '{args.out_dir}': {exc.strerror or exc}") from None
+    # The output folder is made as the first file is written (a task that fails leaves none).
 
 
 def check_chunk_without_manifest(args) -> None:

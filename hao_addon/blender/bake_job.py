@@ -472,7 +472,7 @@ class BakeJob:
         shading, the normals Blender extrudes along, the cage's evaluated corners."""
         req = self.request
         sources = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=req.settings.normals == "mesh",
-                                            alpha=req.settings.alpha != "off")
+                                            alpha=req.settings.alpha != "off", alpha_size=req.settings.size)
                    for o in high_poly]
         normals, linear = mesh_data.extrusion_normals(low, depsgraph)
         cage = None
@@ -534,8 +534,9 @@ class BakeJob:
             high_to_low = self._high_to_low(obj, depsgraph, unit.sources) if unit.sources is not None else None
             target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
             alpha = req.settings.alpha != "off"
-            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha)
-                         for o in unit.occluders]
+            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha,
+                                                  alpha_size=req.settings.size) for o in unit.occluders]
+            alpha_notes = sorted({note for o in occluders if o.alpha is not None for note in o.alpha.notes})
             settings = terminator_settings(req.settings, unit.sources or objects)
             key = None
             if frame is not None:
@@ -570,6 +571,9 @@ class BakeJob:
             if settings.bent_normals:
                 self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
                                                            soup, result)
+            if alpha_notes:
+                result = replace(result, stats={**result.stats,
+                                                "warnings": [*result.stats.get("warnings", []), *alpha_notes]})
             # A texture set's objects share one result (commit writes it once).
             self.results.extend((o, uv_names[o.name], result) for o in objects)
             if key is not None:

@@ -51,12 +51,13 @@ def corner_normals(mesh: bpy.types.Mesh) -> np.ndarray:
 
 
 def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None,
-                   shading_normals: bool = True, alpha: bool = False) -> TriangleSoup:
+                   shading_normals: bool = True, alpha: bool = False, alpha_size: int = 4096) -> TriangleSoup:
     """The object's evaluated mesh in world space, with the named UV map (or none) and, when
     asked, the corner shading normals and (alpha) what its materials let through as an
     occluder (blender/material_alpha.py). A mirroring transform (negative determinant) turns
     the triangles inside out; their corners are reordered so faces keep pointing outwards,
-    as Blender and Cycles treat mirrored objects."""
+    as Blender and Cycles treat mirrored objects. alpha_size: the bake's resolution (alpha
+    textures are read no finer than it can use)."""
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
@@ -75,7 +76,7 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
         lets_through = None
         if alpha:
             from .material_alpha import soup_alpha
-            lets_through = soup_alpha(obj, mesh, tri_loops)
+            lets_through = soup_alpha(obj, mesh, tri_loops, alpha_size)
         return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals, alpha=lets_through)
     finally:
         obj_eval.to_mesh_clear()

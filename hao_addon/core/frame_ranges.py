@@ -14,6 +14,9 @@ from .errors import BakeInputError
 
 # At most this many frames in one --frames (a typo such as 1-100000 is refused).
 MAX_FRAMES = 10_000
+# Blender's frame range (MINAFRAME, MAXFRAME): a scene cannot be set to a frame outside it
+# (it would be clamped silently, and every such frame bake the same scene).
+BLENDER_FRAMES = (-1_048_574, 1_048_574)
 _ITEM = re.compile(r"\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*(?::\s*(\d+))?\s*")
 
 
@@ -31,6 +34,9 @@ def frame_ranges(spec: str) -> list[range]:
         step = int(match.group(3)) if match.group(3) is not None else 1
         if last < first or step < 1:
             raise BakeInputError(f"--frames '{spec}': the range must run forwards (A <= B) with a step of at least 1")
+        if first < BLENDER_FRAMES[0] or last > BLENDER_FRAMES[1]:
+            raise BakeInputError(f"--frames '{spec}': Blender's frames run from {BLENDER_FRAMES[0]} to "
+                                 f"{BLENDER_FRAMES[1]}")
         ranges.append(range(first, last + 1, step))
     count = sum(len(r) for r in ranges)
     if count > MAX_FRAMES:

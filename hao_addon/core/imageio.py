@@ -9,6 +9,7 @@ files get the standard top-row-first orientation.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -127,6 +128,18 @@ def remove_stale_temporaries(path: Path) -> int:
     return removed
 
 
+@contextlib.contextmanager
+def named_write_errors(path: Path):
+    """An OSError while writing path's bytes (a full disk, a quota) names the file: the
+    system's own message names none ('[Errno 28] No space left on device')."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            raise OSError(exc.errno, f"cannot write '{path}': {exc.strerror or exc}") from None
+        raise
+
+
 def _temporary_for(path: Path) -> tuple[int, str]:
     remove_stale_temporaries(path)
     return tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".part", dir=path.parent)
@@ -138,7 +151,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     made = make_folders(path.parent)
     fd, tmp = _temporary_for(path)
     try:
-        with os.fdopen(fd, "wb") as fh:
+        with os.fdopen(fd, "wb") as fh, named_write_errors(path):
             fh.write(data)
         # mkstemp creates 0600; give the file the permissions a plain open() would.
         os.chmod(tmp, 0o666 & ~_umask())
@@ -173,7 +186,7 @@ class StagedFiles:
         self._made += make_folders(path.parent)
         fd, tmp = _temporary_for(path)
         self._staged.append((path, tmp))  # first: removed by discard() even if the write fails
-        with os.fdopen(fd, "wb") as fh:
+        with os.fdopen(fd, "wb") as fh, named_write_errors(path):
             fh.write(data)
         os.chmod(tmp, 0o666 & ~_umask())
 

@@ -29,12 +29,13 @@ class SoupAlpha:
     images: list[np.ndarray] = field(default_factory=list)
     image_index: np.ndarray | None = None
     uvs: np.ndarray | None = None
+    notes: tuple[str, ...] = ()  # what was read as opaque and why (warnings for the report)
 
     def subset(self, mask: np.ndarray) -> "SoupAlpha":
         """The alpha of the faces where mask (F,) bool."""
         if self.image_index is None:
-            return SoupAlpha(self.constant[mask])
-        return SoupAlpha(self.constant[mask], self.images, self.image_index[mask], self.uvs[mask])
+            return SoupAlpha(self.constant[mask], notes=self.notes)
+        return SoupAlpha(self.constant[mask], self.images, self.image_index[mask], self.uvs[mask], self.notes)
 
     @property
     def lets_light_through(self) -> bool:

@@ -94,6 +94,8 @@ class JobOptions:
             raise SettingError("dither", "dither applies to 8-bit PNG files: add --png-bits 8")
         if self.match_names and (not self.low_suffix or not self.high_suffix
                                  or self.low_suffix.lower() == self.high_suffix.lower()):
-            raise SettingError("high_suffix", f"the low and high suffixes must differ and not be empty, got "
-                                              f"'{self.low_suffix}' and '{self.high_suffix}'")
+            # The option named is the one at fault: the empty one, else the high (the second).
+            name = "low_suffix" if not self.low_suffix else "high_suffix"
+            raise SettingError(name, f"the low and high suffixes must differ and not be empty, got "
+                                     f"'{self.low_suffix}' and '{self.high_suffix}'")
         return self
