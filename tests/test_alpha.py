@@ -163,3 +163,86 @@ def test_blender_materials_let_their_alpha_through(scene, kind, through):
     stats = error_stats(result.ao, np.full(result.ao.shape, through), result.covered)
     assert stats["rmse"] <= 1.1 * stochastic_sigma(DIRS, through) and abs(stats["bias"]) < 0.02, stats
     assert result.stats["alpha_faces"] > 0
+
+
+# -- issue 38: alpha a user's scene may hold ---------------------------------------------------------
+
+def _card_scene(kind: str):
+    """The floor under a card whose material is of `kind`; returns (floor, card, material)."""
+    import bpy
+    from conftest import select_only, soup_to_object
+    floor_obj = soup_to_object(floor(), "floor")
+    card_obj = soup_to_object(scenes.grid_plane(200.0, 4, z=H, name="card"), "card")
+    material = _card_material("value" if kind in ("nan", "emission") else "image")
+    if kind == "nan":
+        next(n for n in material.node_tree.nodes if n.type == 'BSDF_PRINCIPLED').inputs['Alpha'].default_value = \
+            float("nan")
+    elif kind == "emission":
+        nodes = material.node_tree.nodes
+        output = next(n for n in nodes if n.type == 'OUTPUT_MATERIAL')
+        material.node_tree.links.new(nodes.new('ShaderNodeEmission').outputs[0], output.inputs['Surface'])
+    elif kind == "missing":
+        image = next(n for n in material.node_tree.nodes if n.type == 'TEX_IMAGE').image
+        image.filepath = "/nonexistent/folder/alpha_mask.png"
+        image.source = 'FILE'
+        image.reload()
+    card_obj.data.materials.append(material)
+    select_only(floor_obj)
+    return floor_obj, card_obj, material
+
+
+def _bake_floor(scene, floor_obj):
+    import bpy
+    from conftest import small_settings
+    from hao_addon.blender.bake_job import BakeJob
+    settings = small_settings(scene, occluders='visible', directions=16, size=32, margin=0, method='gather')
+    job = BakeJob(settings.to_request([floor_obj]), bpy.context.evaluated_depsgraph_get)
+    job.run()
+    return job.results[0][2]
+
+
+def test_a_missing_alpha_image_is_an_error_naming_it_and_its_material(scene):
+    """Before: 'internal error (AttributeError ...)'. A map baked as if the card were opaque
+    (or absent) would be wrong, so it is refused; Alpha off bakes without it."""
+    from hao_addon.core.errors import BakeInputError
+    floor_obj, _card, material = _card_scene("missing")
+    with pytest.raises(BakeInputError, match=r"the image 'alpha_image' \(/nonexistent/folder/alpha_mask.png\) that "
+                                             rf"gives material '{material.name}' its alpha cannot be read"):
+        _bake_floor(scene, floor_obj)
+    scene.hao_bake.alpha = 'off'
+    assert _bake_floor(scene, floor_obj).covered.any()
+
+
+def test_a_nan_alpha_is_refused(scene):
+    from hao_addon.core.errors import BakeInputError
+    floor_obj, _card, material = _card_scene("nan")
+    with pytest.raises(BakeInputError, match=f"material '{material.name}' has an Alpha of nan"):
+        _bake_floor(scene, floor_obj)
+
+
+def test_a_material_that_is_not_principled_is_opaque_with_a_warning(scene):
+    floor_obj, _card, material = _card_scene("emission")
+    result = _bake_floor(scene, floor_obj)
+    assert f"'card': material '{material.name}' is not a Principled BSDF: read as opaque" in result.stats["warnings"]
+    assert result.ao[result.covered].mean() < 0.2  # the card above covers the floor's sky
+
+
+def test_a_large_alpha_texture_is_read_at_the_size_the_bake_resolves(scene, monkeypatch, tmp_path):
+    """A 16k alpha texture took 6.9 GB for a 64^2 bake. Read no finer than max(MAX_ALPHA_SIDE,
+    4 x size): here the limit is lowered so a 512^2 image stands for the 16k one."""
+    import bpy
+    from hao_addon.blender import material_alpha
+    monkeypatch.setattr(material_alpha, "MAX_ALPHA_SIDE", 64)
+    image = bpy.data.images.new("big_alpha", 512, 256, alpha=True)
+    pixels = np.ones((256, 512, 4), np.float32)
+    pixels[:, :256, 3] = 0.0  # the left half lets everything through
+    image.pixels.foreach_set(pixels.ravel())
+    image.filepath_raw, image.file_format = str(tmp_path / "big_alpha.png"), 'PNG'
+    image.save()
+    image.source = 'FILE'
+    image.reload()
+    small = material_alpha.image_alpha(image, "m", bake_size=16)
+    assert small.shape == (32, 64)  # halved until its longer side is within 64
+    assert np.allclose(small[:, :28], 0.0) and np.allclose(small[:, 36:], 1.0)
+    assert material_alpha.image_alpha(image, "m", bake_size=128).shape == (256, 512)  # 4 x 128 covers it
+    assert "big_alpha" in bpy.data.images and len([i for i in bpy.data.images if i.name.startswith("big")]) == 1

@@ -16,6 +16,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from hao_addon.core.farm.manifest import make_manifest, read_manifest
@@ -502,3 +503,112 @@ def test_a_killed_tasks_temporary_files_are_removed_by_its_next_run(tmp_path):
     other.write_bytes(b"x")
     assert hao(["bake", SPOT, "--out-dir", out, *BAKE], tmp_path).returncode == 0
     assert not stale.exists() and other.exists()
+
+
+def _changed_value(field, spec):
+    """A valid value of a setting other than its default (from its own definition)."""
+    default = field.default
+    if spec.choices:
+        return next(c.value for c in spec.choices if c.value != default)
+    if isinstance(default, bool):
+        return not default
+    if isinstance(default, str):
+        return default + "_x"
+    step = 1 if isinstance(default, int) else 0.25
+    value = default + step
+    if spec.maximum is not None and value > spec.maximum:
+        value = default - step
+    return value
+
+
+def test_the_skip_key_covers_every_setting_from_its_definition():
+    """Each BakeSettings and JobOptions setting with an option, changed alone from its
+    default, changes the key: a setting dropped from it (directions, say) fails here."""
+    import argparse
+
+    from hao_addon.cli_parser import build_parser
+    from hao_addon.cli_skip import NOT_IN_KEY, run_key
+    from hao_addon.core.bake.job_options import JobOptions
+    from hao_addon.core.bake.settings import BakeSettings
+    from hao_addon.core.setting_spec import specs
+    base = build_parser().parse_args(["bake", str(SPOT), "--out", "a.png"])
+    key = run_key(base, [SPOT])
+    checked = []
+    for cls in (BakeSettings, JobOptions):
+        for field, spec in specs(cls):
+            option = spec.option(field.name)
+            if option is None:
+                continue
+            dest = option[2:].replace("-", "_")
+            assert dest not in NOT_IN_KEY, dest
+            args = argparse.Namespace(**vars(base))
+            assert hasattr(args, dest), dest
+            setattr(args, dest, _changed_value(field, spec))
+            assert run_key(args, [SPOT]) != key, f"{option} does not change the skip key"
+            checked.append(dest)
+    assert "directions" in checked and "max_distance" in checked and len(checked) >= 30, checked
+    # The input's content counts too.
+    assert run_key(base, [CESIUM]) != key
+
+
+ALPHA_SCENE = r'''
+import os, sys
+import bpy
+import numpy as np
+folder = sys.argv[-1]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+image = bpy.data.images.new("mask", 8, 8, alpha=True)
+image.pixels.foreach_set(np.tile([1.0, 1.0, 1.0, 0.5], 64).astype(np.float32))
+image.filepath_raw, image.file_format = os.path.join(folder, "mask.png"), 'PNG'
+image.save()
+bpy.ops.mesh.primitive_plane_add(size=4)
+bpy.context.active_object.name = "Floor"
+bpy.ops.mesh.primitive_plane_add(size=4, location=(0, 0, 0.5))
+card = bpy.context.active_object
+card.name = "Card"
+material = bpy.data.materials.new("CardMaterial")
+material.use_nodes = True
+nodes = material.node_tree.nodes
+texture = nodes.new('ShaderNodeTexImage')
+texture.image = image
+material.node_tree.links.new(texture.outputs['Alpha'], nodes["Principled BSDF"].inputs['Alpha'])
+card.data.materials.append(material)
+bpy.ops.wm.save_as_mainfile(filepath=os.path.join(folder, "scene.blend"))
+'''
+
+
+@pytest.fixture
+def alpha_scene(tmp_path) -> Path:
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    done = subprocess.run([sys.executable, "-c", ALPHA_SCENE, str(folder)], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return folder
+
+
+def test_the_scenes_textures_are_inputs(alpha_scene, tmp_path):
+    """An alpha texture edited on disk makes the map stale; a map onto a texture the scene's
+    materials read is refused, the texture untouched."""
+    out = tmp_path / "floor.png"
+    args = ["bake", alpha_scene / "scene.blend", "--object", "Floor", "--out", out, "--skip-existing", *BAKE]
+    assert hao(args, tmp_path).returncode == 0
+    again = hao(args, tmp_path)
+    assert again.returncode == 0 and "skipped 'Floor'" in again.stdout
+    mask = alpha_scene / "mask.png"
+    before = mask.read_bytes()
+    for option in ("--out", "--orm-out"):
+        onto = hao(["bake", alpha_scene / "scene.blend", "--object", "Floor", *(["--out", out] if option != "--out"
+                    else []), option, mask, *BAKE], tmp_path)
+        assert onto.returncode == 2 and "would overwrite the image 'mask' that the scene's materials read" \
+            in onto.stderr, onto.stderr
+        assert mask.read_bytes() == before
+    # Edit the texture (another alpha): the map is baked again.
+    import bpy
+    image = bpy.data.images.load(str(mask))
+    image.pixels.foreach_set(np.tile([1.0, 1.0, 1.0, 0.9], 64).astype(np.float32))
+    image.save()
+    bpy.data.images.remove(image)
+    assert mask.read_bytes() != before
+    third = hao(args, tmp_path)
+    assert third.returncode == 0 and "skipped" not in third.stdout, third.stdout

@@ -82,7 +82,8 @@ def image_alpha(image: "bpy.types.Image", material_name: str = "", bake_size: in
     scale = 1
     while max(w, h) // scale > limit:
         scale *= 2
-    if scale == 1:
+    # A copy reloads its pixels from the file: an image edited in Blender and not saved is read whole.
+    if scale == 1 or image.source != 'FILE' or image.is_dirty or image.packed_file is not None:
         pixels = np.empty(w * h * 4, np.float32)
         image.pixels.foreach_get(pixels)
         return pixels.reshape(h, w, 4)[..., 3].copy()
