@@ -78,15 +78,10 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 def _checked_run(args, report: Report) -> _Run:
     """The settings, and every file the run reads and writes, checked before a long load."""
     from .blender.paths import example_path
-    from .core.bake.job_options import JobOptions
-    from .core.bake.settings import BakeSettings
     from .core.imageio import check_writable
 
-    fill_map_outputs(args)
-    settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
-    options = validated(settings_from_args(args, JobOptions), JobOptions)
+    settings, options, frames = checked_options(args)
     source = check_input(Path(args.input), INPUT_FORMATS)
-    frames = parse_frames(args.frames) if args.frames else None
     first_frame = frames[0] if frames else 0
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
@@ -119,6 +114,33 @@ def _checked_run(args, report: Report) -> _Run:
     literal = [(path, what) for path, what in image_outputs(args, to_colors) if not has_token(path)]
     check_output_files(writes + literal, reads)  # again with every file once the objects are known (BakeJob)
     return _Run(settings, options, source, frames, gltf_out, mesh_out, reads, writes, key="")
+
+
+def checked_options(args) -> tuple[object, object, list[int] | None]:
+    """(BakeSettings, JobOptions, frames) of the options, each checked as a bake checks them
+    before it loads anything; a farm job's writer runs the same checks (nothing is refused
+    later, on the farm, that could have been refused at submission)."""
+    from .core.bake.job_options import JobOptions
+    from .core.bake.settings import BakeSettings
+    fill_map_outputs(args)
+    settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
+    options = validated(settings_from_args(args, JobOptions), JobOptions)
+    frames = parse_frames(args.frames) if args.frames else None
+    _check_image_options(args, options, frames)
+    return settings, options, frames
+
+
+def _check_image_options(args, options, frames) -> None:
+    """Options that would be ignored where they do not apply are refused: PNG bits (and the
+    dither) with no PNG output; one glTF file for a sequence of frames."""
+    if frames and args.gltf_out:
+        raise CLIError("--gltf-out writes one mesh with one set of maps, --frames a map per frame: bake the glTF "
+                       "file of one frame without --frames")
+    if str(options.png_bits) != "16" or options.dither:
+        images = [args.out or ""] + [getattr(args, option) or "" for option in IMAGE_OPTIONS]
+        if not any(path.lower().endswith(".png") for path in images):
+            raise CLIError(f"--png-bits {options.png_bits}{' with --dither' if options.dither else ''} is for PNG "
+                           f"files, and every output here is a 32-bit float EXR")
 
 
 def _scene_key(args, run: _Run) -> str:

@@ -144,6 +144,8 @@ def run_farm(args, report: Report, progress) -> list[str]:
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
     _check_farm_outputs(args)
+    from .cli_bake import checked_options
+    checked_options(_with_out(args, template))  # every bake option, as a task would check it
     for path in args.input:
         check_input(Path(path), INPUT_FORMATS)
     outputs = job_outputs(args, template)
@@ -169,6 +171,13 @@ def run_farm(args, report: Report, progress) -> list[str]:
     return [f"hao: wrote the {args.farm_command} job of {len(manifest.entries)} inputs"
             + (f" (frames {manifest.frames})" if manifest.frames else "")
             + f" in {manifest.chunk_count} tasks -> {bundle}"]
+
+
+def _with_out(args, template: str) -> argparse.Namespace:
+    """A copy of the options with --out as a task fills it (its maps named after it)."""
+    copy = argparse.Namespace(**vars(args))
+    copy.out = template
+    return copy
 
 
 def _check_farm_outputs(args) -> None:
@@ -210,7 +219,9 @@ def _check_job_text(farm: str, manifest: Manifest, options: list[str], values: d
     from .core.farm.manifest import text_fault
     texts = [("an input path", manifest.root + "/" + entry) for entry in manifest.entries]
     texts += [("--out", manifest.out), ("--name", name)] + [("a bake option", option) for option in options]
-    texts += [(f"the {key.replace('_', ' ')}", value) for key, value in values.items()]
+    names = {"input_root": "the input folder", "out_dir": "--out-dir", "manifest": "--bundle",
+             "executable": "--executable", "addon": "--addon-path"}
+    texts += [(names[key], value) for key, value in values.items()]
     for what, text in texts:
         fault = text_fault(text)
         if fault:

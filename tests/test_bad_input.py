@@ -78,10 +78,68 @@ bare.name = "Bare"; bare.data.uv_layers.remove(bare.data.uv_layers[0]); save("no
 fresh(); bpy.ops.mesh.primitive_plane_add(size=2); bpy.context.active_object.name = "Low"
 bpy.ops.mesh.primitive_cube_add(location=(0, 0, 3), size=1); bpy.context.active_object.name = "High"
 save("pair.blend")  # the high-poly far above the low-poly: no ray from it finds it
+def alpha_card(name, kind):
+    """A floor under a card whose alpha comes from the image mask.png beside the file
+    ('texture'), from a file that is gone ('missing'), or is NaN ('nan')."""
+    fresh()
+    bpy.ops.mesh.primitive_plane_add(size=4); bpy.context.active_object.name = "Floor"
+    bpy.ops.mesh.primitive_plane_add(size=4, location=(0, 0, 0.5)); card = bpy.context.active_object
+    card.name = "Card"
+    material = bpy.data.materials.new("CardMaterial")
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    if kind == "nan":
+        bsdf.inputs["Alpha"].default_value = float("nan")
+    else:
+        image = bpy.data.images.new("mask", 8, 8, alpha=True)
+        image.pixels.foreach_set(np.tile([1.0, 1.0, 1.0, 0.5], 64).astype(np.float32))
+        path = os.path.join(out, "mask.png" if kind == "texture" else "gone.png")
+        image.filepath_raw, image.file_format = path, 'PNG'
+        image.save()
+        texture = material.node_tree.nodes.new('ShaderNodeTexImage')
+        texture.image = image
+        material.node_tree.links.new(texture.outputs['Alpha'], bsdf.inputs['Alpha'])
+    card.data.materials.append(material)
+    save(name)
+    if kind == "missing":
+        os.remove(os.path.join(out, "gone.png"))
+
+alpha_card("alpha_texture.blend", "texture"); alpha_card("alpha_missing.blend", "missing")
+alpha_card("alpha_nan.blend", "nan")
 fresh(); cube(); bpy.ops.export_scene.gltf(filepath=os.path.join(out, "scene.glb"))
 sys.stdout.flush()
 os._exit(0)  # bpy 4.2 segfaults at interpreter exit after a glTF export
 '''
+
+
+def _with(**changes):
+    return lambda data: {**data, **changes}
+
+
+def _without(name):
+    return lambda data: {k: v for k, v in data.items() if k != name}
+
+
+# Manifests a farm task may be handed, each wrong in one way (issue 38): each is refused with
+# one line naming the fault, nothing written.
+MANIFEST_FAULTS = {
+    "list": "[1, 2]", "null": "null", "empty-file": "", "not-json": "{'version': 2}",
+    "version-1": _with(version=1), "no-root": _without("root"), "no-outputs": _without("outputs"),
+    "chunk-zero": _with(chunk_size=0), "chunk-huge": lambda data: json.dumps(data).replace('"chunk_size": 1', '"chunk_size": 1e400'),
+    "chunk-bool": _with(chunk_size=True), "chunk-text": _with(chunk_size="10"),
+    "entries-text": _with(entries="spot.obj"), "entries-null": _with(entries=[None]),
+    "entries-empty": _with(entries=[]), "entry-absolute": _with(entries=["/etc/passwd"]),
+    "entry-up": _with(entries=["../spot.obj"]), "entries-twice": _with(entries=["spot.obj", "spot.obj"]),
+    "out-nul": _with(out="a\u0000b.png"), "out-path": _with(out="sub/{input}.png"),
+    "root-relative": _with(root="inputs"), "unknown-field": _with(extra=1),
+    "frames-bad": _with(frames="1-x"), "outputs-text": _with(outputs="a.png"),
+    "entry-newline": _with(entries=["a\nb.obj"]),
+}
+# A PNG cut short: its header and key survive, its pixels do not.
+CUT_PNG = (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x10\x00\x00\x00\x10\x10\x00\x00\x00\x00"
+           b"\x8f\x87\xb0\xa6\x00\x00\x01\x00IDAT")
+# A folder name that shells and farm parsers treat specially (accepted: it is data).
+HOSTILE_FOLDER = "-h $(touch PWNED) `touch PWNED` ; & 'q' \"d\" ünï {{x}} {chunk}"
 
 
 @pytest.fixture(scope="module")
@@ -113,9 +171,21 @@ def inputs(tmp_path_factory) -> Path:
         (folder / sub / "x.obj").write_bytes(files["degenerate.obj"])
     for name in ("a b.obj", "a_b.obj"):  # two names that clean to one
         (folder / name).write_bytes(files["degenerate.obj"])
-    (folder / "manifest.json").write_text(json.dumps(  # a farm job's, of one input
-        {"version": 1, "root": str(folder), "entries": ["spot.obj"], "chunk_size": 1, "out": "{input}_ao.png",
-         "frames": ""}))
+    good = {"version": 2, "root": str(folder), "entries": ["spot.obj"], "chunk_size": 1, "out": "{input}_ao.png",
+            "frames": "", "outputs": ["{input}_ao.png"]}
+    (folder / "manifest.json").write_text(json.dumps(good))  # a farm job's, of one input
+    for name, fault in MANIFEST_FAULTS.items():
+        text = fault if isinstance(fault, str) else fault(dict(good))
+        (folder / f"m_{name}.json").write_text(text if isinstance(text, str) else json.dumps(text))
+    for name, out in (("cut", "{input}_cut.png"), ("dir", "{input}_dir.png")):  # outputs Verify must refuse
+        (folder / f"verify_{name}.json").write_text(json.dumps({**good, "out": out, "outputs": [out]}))
+    (folder / "spot_cut.png").write_bytes(CUT_PNG)
+    (folder / "spot_dir.png").mkdir()
+    hostile = folder / HOSTILE_FOLDER
+    hostile.mkdir()
+    shutil.copy(SPOT, hostile / "h.obj")
+    (folder / "new\nline").mkdir()  # a folder name a cuecmd line would split at
+    shutil.copy(SPOT, folder / "new\nline" / "x.obj")
     return folder
 
 
@@ -395,12 +465,190 @@ CASES = [
      2, "--manifest names the inputs: give no INPUT besides it"),
     ("task-chunk-beyond-the-job", [BAKE, "--manifest", "{in}/manifest.json", "--chunk", "5", "--out-dir", "{out}"],
      2, "chunk 5 is not in this job: it has chunks 0 to 0"),
-    ("task-manifest-not-a-manifest", [BAKE, "--manifest", "{in}/spot.obj", "--out-dir", "{out}"], 2,
+    ("task-manifest-not-a-manifest", [BAKE, "--manifest", "{in}/spot.obj", "--chunk", "0", "--out-dir", "{out}"], 2,
      "cannot read the manifest"),
     ("task-manifest-without-out-dir", [BAKE, "--manifest", "{in}/manifest.json"], 2,
      "--manifest needs --out-dir DIR"),
     ("verify-outputs-missing", [FARM, "verify", "--manifest", "{in}/manifest.json", "--out-dir", "{out}"], 1,
      "1 of 1 expected outputs are missing, empty or broken: spot_ao.png"),
+    # issue 38: nothing lost, nothing wrong called success
+    ("verify-output-cut-short", [FARM, "verify", "--manifest", "{in}/verify_cut.json", "--out-dir", "{in}"], 1,
+     "1 of 1 expected outputs are missing, empty or broken: spot_cut.png"),
+    ("verify-folder-in-a-maps-place", [FARM, "verify", "--manifest", "{in}/verify_dir.json", "--out-dir", "{in}"],
+     1, "1 of 1 expected outputs are missing, empty or broken: spot_dir.png"),
+    ("farm-same-name-two-folders", [FARM, "openjd", "{in}/a/x.obj", "{in}/b/x.obj", "--out-dir", "{out}",
+                                    "--bundle", "{out}/job"], 2,
+     "the AO map (--out) of input '{in}/a/x.obj' and the AO map (--out) of input '{in}/b/x.obj' would both be "
+     "written to '{out}/x_ao.png'"),
+    ("farm-names-clean-alike", [FARM, "flamenco", "{in}/a b.obj", "{in}/a_b.obj", "--out-dir", "{out}",
+                                "--bundle", "{out}/job"], 2, "of input '{in}/a_b.obj' would both be written to "
+                                                             "'{out}/a_b_ao.png'"),
+    ("farm-without-input-token", [FARM, "opencue", "{in}/a/x.obj", "{in}/spot.obj", "--out-dir", "{out}",
+                                  "--bundle", "{out}/job", "--out", "m.png"], 2,
+     "--out 'm.png' would write every input's map to the same file: put {input} in it"),
+    ("farm-bent-normals-on-the-map", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle",
+                                      "{out}/job", "--bent-normal-out", "{input}_ao.png"], 2,
+     "the bent normals (--bent-normal-out) of input '{in}/spot.obj' would both be written to '{out}/spot_ao.png'"),
+    ("farm-extra-output-absolute", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                                    "--thickness-out", "/tmp/t.png"], 2,
+     "in a farm job, --thickness-out is a file name in --out-dir (the tasks write every output there)"),
+    ("farm-extra-output-above", [FARM, "flamenco", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                                 "--gltf-out", "../m.glb"], 2, "in a farm job, --gltf-out is a file name in --out-dir"),
+    ("farm-newline-in-an-input-folder", [FARM, "opencue", "{in}/new\nline/x.obj", "--out-dir", "{out}", "--bundle",
+                                         "{out}/job"], 2, "an input path contains a control character (a newline)"),
+    ("farm-newline-in-the-name", [FARM, "opencue", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                                  "--name", "a\nrm -rf b"], 2,
+     "--name contains a control character (a newline): \"a\\nrm -rf b\"; a farm's command line cannot carry it"),
+    ("farm-tab-in-the-out-dir", [FARM, "flamenco", "{in}/spot.obj", "--out-dir", "{out}/o\tp", "--bundle",
+                                 "{out}/job"], 2, "--out-dir contains a control character (a tab)"),
+    ("farm-control-in-the-executable", [FARM, "opencue", "{in}/spot.obj", "--out-dir", "{out}", "--bundle",
+                                        "{out}/job", "--executable", "bl\x01ender"], 2,
+     "--executable contains a control character (U+0001)"),
+    ("farm-carriage-return-in-an-option", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle",
+                                           "{out}/job", "--uv-map", "UV\rMap"], 2,
+     "a bake option contains a control character (a carriage return)"),
+    ("farm-openjd-braces-in-the-name", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle",
+                                        "{out}/job", "--name", "job {{Param.OutputDir}}"], 2,
+     "--name holds '{{' or '}}', which Open Job Description reads as its own format string"),
+    ("farm-openjd-braces-in-an-option", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle",
+                                         "{out}/job", "--bent-normal-out", "b}}.png"], 2,
+     "a bake option holds '{{' or '}}'"),
+    ("farm-chunk-size-huge", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                              "--chunk-size", "2000000"], 2, "--chunk-size must be at least 1 and at most 1000000"),
+    ("farm-frames-past-blender", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                                  "--frames", "2000000"], 2, "Blender's frames run from -1048574 to 1048574"),
+    ("farm-gltf-of-frames", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                             "--gltf-out", "{input}.glb", "--frames", "1-3"], 2,
+     "--gltf-out writes one mesh with one set of maps, --frames a map per frame"),
+    ("farm-setting-out-of-range", [FARM, "flamenco", "{in}/spot.obj", "--out-dir", "{out}", "--bundle", "{out}/job",
+                                   "--size", "8"], 2, "map size must be between 16 and 16384 texels, got 8 (--size)"),
+    ("task-manifest-without-chunk", [BAKE, "--manifest", "{in}/manifest.json", "--out-dir", "{out}"], 2,
+     "--manifest needs --chunk N: the task's chunk of the job"),
+    ("task-chunk-without-manifest", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--chunk", "3"], 2,
+     "--chunk and --input-root belong to a farm task's --manifest"),
+    ("task-out-beside-manifest", [BAKE, "--manifest", "{in}/manifest.json", "--chunk", "0", "--out-dir", "{out}",
+                                  "--out", "x.png"], 2, "--manifest names the output files: give no --out besides it"),
+    ("task-frames-beside-manifest", [BAKE, "--manifest", "{in}/manifest.json", "--chunk", "0", "--out-dir", "{out}",
+                                     "--frames", "1-2"], 2, "--manifest names the frames of each chunk"),
+    ("scene-texture-as-the-map", [BAKE, "{in}/alpha_texture.blend", "--object", "Floor", "--out", "{in}/mask.png",
+                                  "--size", "16"], 2,
+     "the AO map of 'Floor' would overwrite the image 'mask' that the scene's materials read"),
+    ("scene-texture-as-the-orm", [BAKE, "{in}/alpha_texture.blend", "--object", "Floor", "--out", "{out}/a.png",
+                                  "--orm-out", "{in}/mask.png", "--size", "16"], 2,
+     "the ORM texture of 'Floor' would overwrite the image 'mask'"),
+    ("alpha-image-missing", [BAKE, "{in}/alpha_missing.blend", "--object", "Floor", "--out", "{out}/a.png",
+                             "--size", "16"], 2, "that gives material 'CardMaterial' its alpha cannot be read"),
+    ("alpha-nan", [BAKE, "{in}/alpha_nan.blend", "--object", "Floor", "--out", "{out}/a.png", "--size", "16"], 2,
+     "material 'CardMaterial' has an Alpha of nan"),
+    ("spread-angle-without-a-direction", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--spread-angle", "1e-9"],
+     2, "the map would be white; raise the spread angle or Directions"),
+    ("spread-angle-zero", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--spread-angle", "0"], 2,
+     "spread angle must be above 0 and at most 90 degrees"),
+    ("frames-past-blender", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "1048575"], 2,
+     "--frames '1048575': Blender's frames run from"),
+    ("frames-before-blender", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--frames", "-2000000--1999999"], 2,
+     "--frames '-2000000--1999999': Blender's frames run from"),
+    ("low-suffix-empty", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--match-names", "--low-suffix", ""], 2,
+     "got '' and '_high' (--low-suffix)"),
+    ("png-bits-for-exr", [BAKE, "{in}/spot.obj", "--out", "{out}/a.exr", "--png-bits", "8"], 2,
+     "--png-bits 8 is for PNG files, and every output here is a 32-bit float EXR"),
+    ("gltf-of-frames", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--gltf-out", "{out}/a.glb", "--frames", "1-2"],
+     2, "bake the glTF file of one frame without --frames"),
+    ("alpha-clip-above-one", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--alpha-clip", "2"], 2,
+     "alpha clip must be between 0 and 1, got 2.0 (--alpha-clip)"),
+    ("min-distance-negative", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--min-distance", "-1"], 2,
+     "min distance must be at least 0 scene units"),
+    ("thickness-distance-negative", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--thickness-out",
+                                     "{out}/t.png", "--thickness-distance", "-1"], 2,
+     "thickness distance must be at least 0 scene units"),
+    ("terminator-offset-above-one", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--terminator-offset", "2"], 2,
+     "terminator offset must be between 0 and 1"),
+    ("verify-negative", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--verify", "-1"], 2,
+     "verified texels must be between 0 and 100000"),
+    ("verify-bound-above-half", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--verify", "5",
+                                 "--verify-max-error", "2"], 2, "verify max error must be between 0 and 0.5"),
+    ("cage-extrusion-nan", [BAKE, "{in}/pair.blend", "--out", "{out}/a.png", "--object", "Low", "--high-poly",
+                            "High", "--cage-extrusion", "nan"], 2, "cage extrusion must be a finite number"),
+    ("view-samples-above-64", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--view-samples", "100"], 2,
+     "view samples must be between 0.25 and 64, got 100.0"),
+    ("directions-beyond-the-limit", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--directions", "100000000"],
+     2, "directions must be between 1 and 65536"),
+    ("thickness-is-the-map", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--thickness-out", "{out}/a.png"], 2,
+     "the AO map (--out) and the thickness map (--thickness-out) would both be written to"),
+    ("orm-is-the-bent-normals", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--orm-out", "{out}/b.png",
+                                 "--bent-normal-out", "{out}/b.png"], 2,
+     "the bent normals (--bent-normal-out) and the ORM texture (--orm-out) would both be written to"),
+    ("error-is-the-thickness", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--error-out", "{out}/t.png",
+                                "--thickness-out", "{out}/t.png"], 2,
+     "the thickness map (--thickness-out) and the error map (--error-out) would both be written to"),
+    ("maps-thickness-onto-the-map", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "thickness",
+                                     "--thickness-out", "{out}/A.png"], 2,
+     "the AO map (--out) and the thickness map (--thickness-out) would both be written to '{out}/A.png'"),
+    ("high-poly-empty-name", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--high-poly", ""], 2,
+     "--high-poly '' is neither a mesh file nor a mesh in the input (meshes: spot)"),
+    ("quality-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--quality", "9-bit"], 2,
+     "argument --quality: invalid choice: '9-bit'"),
+    ("occluders-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--occluders", "none"], 2,
+     "argument --occluders: invalid choice: 'none'"),
+    ("png-bits-unknown", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--png-bits", "12"], 2,
+     "argument --png-bits: invalid choice: '12'"),
+    *[(f"task-manifest-{name}", [BAKE, "--manifest", f"{{in}}/m_{name}.json", "--chunk", "0", "--out-dir", "{out}"], 2,
+       message) for name, message in {
+        "list": "is not a job manifest of this hao: expected an object, found list",
+        "null": "is not a job manifest of this hao: expected an object, found NoneType",
+        "empty-file": "cannot read the manifest '{in}/m_empty-file.json': Expecting value",
+        "not-json": "cannot read the manifest '{in}/m_not-json.json': Expecting property name",
+        "version-1": "version 1, this hao reads 2", "no-root": "'root' is missing",
+        "no-outputs": "'outputs' is missing",
+        "chunk-zero": "'chunk_size' must be between 1 and 1000000, found 0",
+        "chunk-huge": "'chunk_size' must be a whole number, found Infinity",
+        "chunk-bool": "'chunk_size' must be a whole number, found true",
+        "chunk-text": "'chunk_size' must be a whole number, found \"10\"",
+        "entries-text": "'entries' must be a list, found \"spot.obj\"",
+        "entries-null": "'entries' must hold non-empty text, found null", "entries-empty": "'entries' is empty",
+        "entry-absolute": "'entries' entry \"/etc/passwd\" must be a path relative to its folder",
+        "entry-up": "'entries' entry \"../spot.obj\" must be a path relative",
+        "entries-twice": "an input is named twice in 'entries'",
+        "out-nul": "'out' contains a control character (NUL)", "out-path": "'out' must be a file name",
+        "root-relative": "'root' must be an absolute folder", "unknown-field": "unknown field 'extra'",
+        "frames-bad": "has a bad frame range: --frames '1-x'", "outputs-text": "'outputs' must be a list",
+        "entry-newline": "'entries' entry \"a\\nb.obj\" contains a control character (a newline)",
+    }.items()],
+    ("verify-manifest-faulty", [FARM, "verify", "--manifest", "{in}/m_chunk-zero.json", "--out-dir", "{out}"], 2,
+     "the manifest '{in}/m_chunk-zero.json' is not a job manifest of this hao"),
+]
+
+
+SMALL = ["--size", "16", "--directions", "4", "--margin", "1"]
+JOB_FILES = {"openjd": ["job/asset_references.json", "job/job_parameters.json", "job/manifest.json",
+                        "job/parameter_values.json", "job/template.json"],
+             "flamenco": ["job/hao_bake.js", "job/job.json", "job/manifest.json"],
+             "opencue": ["job/hao_commands.txt", "job/manifest.json"]}
+# Input that is odd but valid (issue 38): exit 0 with exactly these files in the output folder,
+# the inputs untouched. (id, arguments, the files written, relative to {out})
+ACCEPTED = [
+    ("hostile-folder-bake", [BAKE, "{in}/" + HOSTILE_FOLDER + "/h.obj", "--out", "{out}/h.png", *SMALL], ["h.png"]),
+    *[(f"hostile-folder-farm-{kind}", [FARM, kind, "{in}/" + HOSTILE_FOLDER + "/h.obj", "--out-dir",
+                                       "{out}/-o $(touch PWNED) {{x}}", "--bundle", "{out}/job", *SMALL], files)
+      for kind, files in JOB_FILES.items()],
+    ("hostile-output-name", [BAKE, "{in}/spot.obj", "--out", "{out}/-a $(touch PWNED) 'q' ünï 漢.png", *SMALL],
+     ["-a $(touch PWNED) 'q' ünï 漢.png"]),
+    ("maps-empty", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "", *SMALL], ["a.png"]),
+    ("maps-named-twice", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--maps", "ao,thickness,thickness", *SMALL],
+     ["a.png", "a_thickness.png"]),
+    ("thickness-within-nothing", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--thickness-out", "{out}/t.exr",
+                                  "--thickness-distance", "1e-30", *SMALL], ["a.png", "t.exr"]),
+    ("spread-angle-sparse", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--spread-angle", "20", *SMALL,
+                             "--directions", "64"], ["a.png"]),  # about 7.5 directions in the cone: a warning
+    ("farm-extra-outputs-in-the-out-dir", [FARM, "openjd", "{in}/spot.obj", "--out-dir", "{out}/maps", "--bundle",
+                                           "{out}/job", "--thickness-out", "{input}_t.png", "--gltf-out",
+                                           "{input}.glb"], JOB_FILES["openjd"]),
+    ("png-bits-for-one-png-of-two", [BAKE, "{in}/spot.obj", "--out", "{out}/a.exr", "--png-bits", "8",
+                                     "--thickness-out", "{out}/t.png", *SMALL], ["a.exr", "t.png"]),
+    ("alpha-texture-read", [BAKE, "{in}/alpha_texture.blend", "--object", "Floor", "--out", "{out}/a.png", *SMALL],
+     ["a.png"]),
+    ("alpha-missing-with-alpha-off", [BAKE, "{in}/alpha_missing.blend", "--object", "Floor", "--out",
+                                      "{out}/a.png", "--alpha", "off", *SMALL], ["a.png"]),
 ]
 
 
@@ -434,6 +682,8 @@ def cli_runs(inputs, tmp_path_factory) -> tuple[dict, dict]:
     inputs' digest before them all (each case checks it after them all)."""
     before = digest(inputs)
     prepared = {case[0]: _case_args(case, inputs, tmp_path_factory.mktemp(case[0])) for case in CASES}
+    prepared |= {case[0]: _case_args((*case[:2], 0, ""), inputs, tmp_path_factory.mktemp(case[0]))
+                 for case in ACCEPTED}
 
     def run(name: str):
         args, _message, _out, tmp = prepared[name]
@@ -456,15 +706,29 @@ def test_cli_bad_input(inputs, cli_runs, case):
     assert digest(inputs) == before  # no case changed an input (all of them have run)
 
 
+@pytest.mark.parametrize("case", ACCEPTED, ids=[c[0] for c in ACCEPTED])
+def test_cli_odd_but_valid_input(inputs, cli_runs, case):
+    name, _template, files = case
+    results, before = cli_runs
+    proc, _message, out, tmp = results[name]
+    assert proc.returncode == 0, proc.stderr
+    assert all(line.startswith("hao: warning: ") for line in proc.stderr.splitlines()), proc.stderr
+    written = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
+    assert written == sorted(files), written
+    assert list(tmp.iterdir()) == [] and not list(out.rglob("PWNED")) and not list(tmp.parent.rglob("PWNED"))
+    assert digest(inputs) == before
+
+
 def test_enough_classes():
-    """Issue 28: at least 100 classes across both entry points (the command line's here, the
+    """Issue 28, then 38: at least 200 classes across both entry points (the command line's here, the
     operators' below), a class being a refusal the user is told apart: cases that expect the
     same message count once (renaming a copy of a case adds nothing), argparse's own
     messages ('invalid choice', 'unrecognized arguments', ...) once each."""
     told = {("cli", c[3]) for c in CASES}
     told |= {("operator", c[-1]) for c in BAKE_OPERATOR_CASES + RENDER_OPERATOR_CASES}
-    assert len({c[0] for c in CASES}) == len(CASES)
-    assert len(told) >= 100, len(told)
+    told |= {("accepted", c[0]) for c in ACCEPTED}
+    assert len({c[0] for c in CASES + ACCEPTED}) == len(CASES) + len(ACCEPTED)
+    assert len(told) >= 200, len(told)  # issue 38
 
 
 # -- operators ------------------------------------------------------------------------------------

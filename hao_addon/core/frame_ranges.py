@@ -34,13 +34,13 @@ def frame_ranges(spec: str) -> list[range]:
         step = int(match.group(3)) if match.group(3) is not None else 1
         if last < first or step < 1:
             raise BakeInputError(f"--frames '{spec}': the range must run forwards (A <= B) with a step of at least 1")
-        if first < BLENDER_FRAMES[0] or last > BLENDER_FRAMES[1]:
-            raise BakeInputError(f"--frames '{spec}': Blender's frames run from {BLENDER_FRAMES[0]} to "
-                                 f"{BLENDER_FRAMES[1]}")
         ranges.append(range(first, last + 1, step))
     count = sum(len(r) for r in ranges)
     if count > MAX_FRAMES:
         raise BakeInputError(f"--frames '{spec}' asks for {count} frames, more than {MAX_FRAMES}")
+    if any(r and (r[0] < BLENDER_FRAMES[0] or r[-1] > BLENDER_FRAMES[1]) for r in ranges):
+        raise BakeInputError(f"--frames '{spec}': Blender's frames run from {BLENDER_FRAMES[0]} to "
+                             f"{BLENDER_FRAMES[1]}")
     return ranges
 
 
