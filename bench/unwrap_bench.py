@@ -16,6 +16,11 @@ Mesh: the Stanford bunny (69,451 triangles, bench/data). Per atlas and texture s
 - seam length: 3D length of the edges cut into two charts, in bounding-box units;
 - density p05: the texel density (UV area / surface area, relative to the mesh's mean) that
   5 % of the surface falls below: how unevenly the texels are spread.
+Meshes as Blender users have them, without UVs: Suzanne (quads), Suzanne
+subdivided once, a cube subdivided once, a 24-sided cylinder (n-gon caps), CesiumMan and
+fandisk: the unwrap as a bake runs it, charts of whole polygons, against the same unwrap
+with each triangle on its own (before), each written into Blender's per-corner UV map and
+measured there: seconds, coverage, and texel centres inside two triangles (overlapping).
 Writes unwrap_bench.json and unwrap_bench.png into the output folder.
 """
 from __future__ import annotations
@@ -132,11 +137,75 @@ def seam_length(unit: np.ndarray, triangles: np.ndarray, uvs: np.ndarray) -> flo
     return float(np.linalg.norm(unit[ends[i[cut], 0]] - unit[ends[i[cut], 1]], axis=1).sum())
 
 
+def _polygon_mesh(name: str):
+    """A Blender mesh object without UVs, by name (see the module's docstring)."""
+    import bpy
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    data = ROOT / "tests" / "data"
+    if name.startswith("suzanne"):
+        bpy.ops.mesh.primitive_monkey_add()
+    elif name == "cube-subdivided":
+        bpy.ops.mesh.primitive_cube_add()
+    elif name == "cylinder-ngons":
+        bpy.ops.mesh.primitive_cylinder_add(vertices=24)
+    elif name == "cesium-man":
+        bpy.ops.import_scene.gltf(filepath=str(data / "CesiumMan.glb"))
+    else:
+        bpy.ops.wm.obj_import(filepath=str(data / "fandisk.obj"))
+    obj = max((o for o in bpy.data.objects if o.type == 'MESH'), key=lambda o: len(o.data.polygons))
+    levels = {"suzanne-subdivided": 1, "cube-subdivided": 1}.get(name, 0)
+    if levels:
+        modifier = obj.modifiers.new("Subdivision", 'SUBSURF')
+        modifier.levels = levels
+        with bpy.context.temp_override(object=obj, active_object=obj):
+            bpy.ops.object.modifier_apply(modifier=modifier.name)
+    while obj.data.uv_layers:
+        obj.data.uv_layers.remove(obj.data.uv_layers[0])
+    return obj
+
+
+POLYGON_MESHES = ("suzanne-quads", "suzanne-subdivided", "cube-subdivided", "cylinder-ngons", "cesium-man", "fandisk")
+
+
+def polygon_rows(sizes: list[int]) -> list[dict]:
+    """Per mesh and size: the unwrap of whole polygons and of single triangles (before),
+    measured as written into the mesh's UV map."""
+    from hao_addon.blender.mesh_data import add_uv_layer, base_mesh_triangles, written_triangle_uvs
+    from hao_addon.core.bake.charts import overlapping_texels
+    rows = []
+    for name in POLYGON_MESHES:
+        obj = _polygon_mesh(name)
+        positions, triangles, loops, polygons = base_mesh_triangles(obj)
+        for size in sizes:
+            for charts, given in (("whole polygons", polygons), ("single triangles (before)", None)):
+                start = time.perf_counter()
+                uvs = run_unwrap(positions, triangles, size, polygons=given)
+                seconds = time.perf_counter() - start
+                layer = add_uv_layer(obj.data, "bench", loops, uvs)
+                written = written_triangle_uvs(obj.data, layer, loops)
+                obj.data.uv_layers.remove(obj.data.uv_layers[layer])
+                overlap, covered = overlapping_texels(written, size)
+                rows.append({"mesh": name, "polygons": len(obj.data.polygons), "triangles": int(len(triangles)),
+                             "charts": charts, "size": size, "seconds": seconds,
+                             "coverage": covered / size ** 2, "overlapping_texels": overlap,
+                             "overlap_fraction": overlap / max(covered, 1)})
+                print(json.dumps(rows[-1]), flush=True)
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=str(ROOT / "bench" / "results"))
     parser.add_argument("--sizes", type=int, nargs="+", default=[256, 1024])
+    parser.add_argument("--polygons-only", action="store_true",
+                        help="only the meshes of polygons (the bunny's rows are kept from the last run)")
     args = parser.parse_args()
+    out = Path(args.out)
+    if args.polygons_only:
+        result = json.loads((out / "unwrap_bench.json").read_text())
+        result["polygon_meshes"] = polygon_rows(args.sizes)
+        (out / "unwrap_bench.json").write_text(json.dumps(result, indent=1) + "\n")
+        return
     vertices, triangles, _uv, _tuv = read_obj(BUNNY)
     triangles = np.asarray(triangles, np.int64)
     unit = unit_copy(vertices, triangles)
@@ -159,8 +228,7 @@ def main() -> None:
     result = {"mesh": "stanford-bunny.obj", "triangles": int(len(triangles)), "padding_texels": DEFAULT_PADDING,
               "machine": {"cpu_count": __import__("os").cpu_count(), "python": platform.python_version(),
                           "blender": bpy.app.version_string},
-              "rows": rows}
-    out = Path(args.out)
+              "rows": rows, "polygon_meshes": polygon_rows(args.sizes)}
     out.mkdir(parents=True, exist_ok=True)
     (out / "unwrap_bench.json").write_text(json.dumps(result, indent=1) + "\n")
     plot(result, out / "unwrap_bench.png")

@@ -103,7 +103,7 @@ def _imported(path):
 UNWRAP_MESHES = {
     "suzanne-quads": lambda: _added(bpy.ops.mesh.primitive_monkey_add),
     "suzanne-subdivided": lambda: _subdivided(_added(bpy.ops.mesh.primitive_monkey_add)),
-    "cube-subdivided": lambda: _subdivided(_added(bpy.ops.mesh.primitive_cube_add), 2),
+    "cube-subdivided": lambda: _subdivided(_added(bpy.ops.mesh.primitive_cube_add)),
     "cylinder-ngons": lambda: _added(bpy.ops.mesh.primitive_cylinder_add, vertices=24),
     "cesium-man": lambda: _imported(DATA / "CesiumMan.glb"),
     "fandisk": lambda: _imported(DATA / "fandisk.obj"),
