@@ -612,3 +612,68 @@ def test_the_scenes_textures_are_inputs(alpha_scene, tmp_path):
     assert mask.read_bytes() != before
     third = hao(args, tmp_path)
     assert third.returncode == 0 and "skipped" not in third.stdout, third.stdout
+
+
+def test_verify_wants_every_frame_and_every_udim_tile(tmp_path):
+    """A frame's map deleted fails Verify naming that frame's file; a map on UDIM tiles is
+    checked tile by tile as its task recorded them; a stray tile never stands for a map."""
+    from test_cli_runs import write_obj
+    from test_udim import TILES, combined, islands
+    out, bundle = tmp_path / "out", tmp_path / "bundle"
+    write_bundle("openjd", [CESIUM], out, bundle, tmp_path, "--frames", "1-3", "--chunk-size", "3", *BAKE)
+    assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode == 0
+    assert run_task(bundle, "Verify", tmp_path, "--no-run-dependencies").returncode == 0
+    (out / "CesiumMan_ao_0002.png").unlink()
+    verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+    assert verify.returncode != 0 and "1 of 3 expected outputs are missing, empty or broken: CesiumMan_ao_0002.png" \
+        in verify.stdout
+    # UDIM tiles: each one the task wrote must be there and whole.
+    source = tmp_path / "udim" / "tiles.obj"
+    source.parent.mkdir()
+    write_obj(source, {"udim": combined(islands(), TILES)})
+    out, bundle = tmp_path / "out_udim", tmp_path / "bundle_udim"
+    write_bundle("openjd", [source], out, bundle, tmp_path, "--out", "{input}.<UDIM>.png", *BAKE)
+    assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode == 0
+    assert maps(out) == [f"tiles.{tile}.png" for tile in TILES]
+    assert run_task(bundle, "Verify", tmp_path, "--no-run-dependencies").returncode == 0
+    (out / f"tiles.{TILES[1]}.png").write_bytes(b"")
+    verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+    assert verify.returncode != 0 and "1 of 1 expected outputs are missing, empty or broken: tiles.<UDIM>.png" \
+        in verify.stdout
+
+
+def test_a_stray_tile_never_stands_for_a_map(job_inputs, tmp_path):
+    files = [job_inputs / "a.obj"]
+    out, bundle = tmp_path / "out", tmp_path / "bundle"
+    write_bundle("openjd", files, out, bundle, tmp_path, *BAKE)
+    assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode == 0
+    (out / "a_ao.png").rename(out / "a_ao.1001.png")
+    verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+    assert verify.returncode != 0 and "1 of 1 expected outputs are missing, empty or broken: a_ao.png" in verify.stdout
+    shutil.rmtree(out / ".hao-job")  # without the task's receipt: the exact name only
+    verify = run_task(bundle, "Verify", tmp_path, "--no-run-dependencies")
+    assert verify.returncode != 0 and "a_ao.png" in verify.stdout
+
+
+def test_every_output_kind_of_a_farm_task_lands_in_the_out_dir(job_inputs, tmp_path):
+    """Relative extra outputs are names in --out-dir: before, they went to the session's
+    scratch folder, which openjd deletes, and the job still passed."""
+    out, bundle, cwd = tmp_path / "out", tmp_path / "bundle", tmp_path / "elsewhere"
+    cwd.mkdir()
+    write_bundle("openjd", [job_inputs / "a.obj"], out, bundle, cwd, "--bent-normal-out", "{input}_bent.png",
+                 "--thickness-out", "{input}_thick.exr", "--orm-out", "{input}_orm.png", "--error-out",
+                 "{input}_err.exr", "--gltf-out", "{input}.glb", *BAKE)
+    manifest = read_manifest(bundle / "manifest.json")
+    assert manifest.outputs == ("{input}_ao.png", "{input}_bent.png", "{input}_thick.exr", "{input}_orm.png",
+                                "{input}_err.exr", "{input}.glb")
+    assert run_task(bundle, "Bake", cwd, "-tp", "Chunk=0").returncode == 0
+    assert maps(out) == ["a.glb", "a_ao.png", "a_bent.png", "a_err.exr", "a_orm.png", "a_thick.exr"]
+    assert list(cwd.iterdir()) == []
+    assert run_task(bundle, "Verify", cwd, "--no-run-dependencies").returncode == 0
+
+
+def test_a_failed_task_leaves_no_folder_behind(job_inputs, tmp_path):
+    out, bundle = tmp_path / "not" / "yet", tmp_path / "bundle"
+    write_bundle("openjd", [job_inputs / "broken.obj"], out, bundle, tmp_path, *BAKE)
+    assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode != 0
+    assert not (tmp_path / "not").exists()

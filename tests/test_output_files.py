@@ -141,3 +141,32 @@ def test_the_largest_extrusion_is_where_float32_resolves_the_meshs_detail():
         (size * 10 * EXTRUSION_RESOLUTION / FLOAT32_SPACING - 20.0))
     scaled = max_extrusion(TriangleSoup(tri, None, name="t"), HighToLow([], low_linear=np.eye(3) * 4.0))
     assert scaled == pytest.approx(limit / 4.0)
+
+
+def test_a_full_disk_names_the_file_and_leaves_nothing(tmp_path, monkeypatch):
+    """The system's own message names no file ('[Errno 28] No space left on device')."""
+    import errno
+
+    from hao_addon.core import imageio
+
+    class Full:
+        def __init__(self, fd, mode):
+            os.close(fd)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def write(self, data):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    monkeypatch.setattr(imageio.os, "fdopen", Full)
+    target = tmp_path / "sub" / "ao.png"
+    with pytest.raises(OSError, match=f"cannot write '{target}': No space left on device"):
+        imageio.atomic_write_bytes(target, b"x" * 10)
+    staged = imageio.StagedFiles()
+    with pytest.raises(OSError, match="cannot write '.*b.png': No space left on device"):
+        staged.write_bytes(tmp_path / "b.png", b"x")
+    staged.discard()
+    assert list(tmp_path.iterdir()) == []

@@ -133,3 +133,18 @@ def test_cli_and_panel_write_the_thickness_map_beside_the_ao(scene, tmp_path):
     image.pixels.foreach_get(px)
     assert abs(float(np.median(px[0::4])) - 0.25) < 0.05  # (d / 2R)^2, as above
     assert (tmp_path / "ball_t.png").is_file()
+
+
+@pytest.mark.parametrize("method", bakers_with("thickness"))
+def test_nothing_is_thick_within_no_distance_on_a_smooth_mesh(gpu_context, method):
+    """Issue 38: a smooth-shaded mesh gave thickness up to 0.47 within a distance of 1e-30:
+    about its shading normals, the directions below a face counted as walls at distance 0.
+    Thickness is taken about the true inverted faces: nothing within reach is 0."""
+    ball = scenes.uv_sphere(1.0, (0, 0, 0), 16, 8, name="ball")
+    smooth = replace(ball, normals=ball.positions / np.linalg.norm(ball.positions, axis=2, keepdims=True))
+    s = replace(settings(method, thickness=True), directions=64)
+    for distance, most in ((1e-30, 0.0), (1e-6, 0.0)):
+        res = drain(thickness_steps(smooth, replace(s, thickness_distance=distance), use_cache=False))
+        assert res.ao[res.covered].max() <= most, (distance, res.ao[res.covered].max())
+    deep = drain(thickness_steps(smooth, replace(s, thickness_distance=2.0), use_cache=False))
+    assert deep.ao[deep.covered].mean() > 0.9  # the whole ball within reach: thick
