@@ -232,6 +232,11 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     if twin is not None:
         twin = np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
     error = None if twin is None else estimate(twin, covered, count)
+    if not covered.any() and target.kind_name != "corners":
+        # A map of no texel is not a bake: a success here would hand back an empty image.
+        raise BakeInputError(f"'{target.name}': no texel centre of the {settings.size}x{settings.size} map lies "
+                             f"inside its UV triangles (they lie outside the 0..1 tile, or are smaller than a "
+                             f"texel): nothing to bake; check its UV map")
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "cache_hit": False, "error": None if error is None else error.as_dict()}
     tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)

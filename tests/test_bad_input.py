@@ -160,6 +160,8 @@ def inputs(tmp_path_factory) -> Path:
         "noface.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\n",
         "degenerate.obj": b"v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n",
         "zerouv.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1\n",
+        "uv_outside.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt -0.9 -0.9\nvt -0.1 -0.9\nvt -0.9 -0.1\nf 1/1 2/2 3/3\n",
+        "uv_tiny.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nvt 0.50001 0.5\nvt 0.5 0.50001\nf 1/1 2/2 3/3\n",
         "mesh.fbx": b"Kaydara FBX Binary  \x00", "spot.obj.png": b"not an image",
     }
     for name, data in files.items():
@@ -540,6 +542,10 @@ CASES = [
                              "--size", "16"], 2, "that gives material 'CardMaterial' its alpha cannot be read"),
     ("alpha-nan", [BAKE, "{in}/alpha_nan.blend", "--object", "Floor", "--out", "{out}/a.png", "--size", "16"], 2,
      "material 'CardMaterial' has an Alpha of nan"),
+    ("uvs-outside-the-tile", [BAKE, "{in}/uv_outside.obj", "--out", "{out}/a.png", "--size", "16"], 2,
+     "'uv_outside': no texel centre of the 16x16 map lies inside its UV triangles"),
+    ("uvs-smaller-than-a-texel", [BAKE, "{in}/uv_tiny.obj", "--out", "{out}/a.png", "--size", "16",
+                                  "--directions", "8"], 2, "'uv_tiny': no texel centre of the 16x16 map lies inside"),
     ("spread-angle-without-a-direction", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--spread-angle", "1e-9"],
      2, "the map would be white; raise the spread angle or Directions"),
     ("spread-angle-zero", [BAKE, "{in}/spot.obj", "--out", "{out}/a.png", "--spread-angle", "0"], 2,
