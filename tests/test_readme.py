@@ -55,3 +55,5 @@ def test_bad_input_class_count_is_the_suite_s():
                                                   test_bad_input.test_render_operator_bad_input)
                          for m in f.pytestmark if m.name == "parametrize")
     assert stated == len(test_bad_input.CASES) + operator_cases
+    accepted = int(re.search(r"and (\d+) classes of odd but valid input", COMMAND_LINE_PAGE).group(1))
+    assert accepted == len(test_bad_input.ACCEPTED)
