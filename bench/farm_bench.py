@@ -127,7 +127,7 @@ def main() -> None:
                 folder.mkdir()
             times["local batch"].append(run(hao("bake", *inputs, "--out-dir", folders["local batch"], *BAKE,
                                                 "--quiet"), tmp))
-            times["the task's command"].append(run([str(folders["the task's command"]) if a == "{out}" else a
+            times["the task's command"].append(run([a.replace("{out}", str(folders["the task's command"]))
                                                     for a in command], tmp))
             wall, session = task_runs(tmp / "one", 1, tmp, folders["one farm task"])
             times["one farm task"].append(session)

@@ -358,7 +358,7 @@ def validated(settings, settings_cls):
 
 def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
-    from .blender.paths import input_file_name
+    from .core.output_files import input_file_name
     name = input_file_name(path)
     for option in ("out", *IMAGE_OPTIONS, "gltf_out"):
         value = getattr(args, option)

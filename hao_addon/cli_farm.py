@@ -266,7 +266,7 @@ def expected_outputs(manifest: Manifest, entry: str) -> list[tuple[int | None, s
     """(frame or None, file name in the output folder) of every file the Bake step writes
     for one input: each of manifest.outputs, '{input}' filled, per frame; '{object}' and
     UDIM tiles stay as tokens (the task's receipt names those files)."""
-    from .blender.paths import input_file_name
+    from .core.output_files import input_file_name
     from .core.frame_ranges import parse_frames
     from .core.output_files import FRAME_TOKEN, INPUT_TOKEN, frame_file, with_token
     frames = parse_frames(manifest.frames) if manifest.frames else [None]

@@ -677,3 +677,14 @@ def test_a_failed_task_leaves_no_folder_behind(job_inputs, tmp_path):
     write_bundle("openjd", [job_inputs / "broken.obj"], out, bundle, tmp_path, *BAKE)
     assert run_task(bundle, "Bake", tmp_path, "-tp", "Chunk=0").returncode != 0
     assert not (tmp_path / "not").exists()
+
+
+def test_file_names_are_cleaned_as_blender_cleans_them_without_loading_it():
+    """{input} names come from core.output_files.clean_name (a farm writer loads no Blender),
+    Blender's bpy.path.clean_name character for character."""
+    import bpy
+
+    from hao_addon.core.output_files import clean_name
+    names = ["spot", "a b", "a_b", "x-y.z", "ünï 漢 ÿ", "$(touch x) `y` ; & 'q' \"d\"", "".join(map(chr, range(300)))]
+    for name in names:
+        assert clean_name(name) == bpy.path.clean_name(name), name

@@ -8,6 +8,7 @@ import bpy
 
 from ..core.errors import BakeInputError
 from ..core.output_files import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN  # noqa: F401 - this module's names too
+from ..core.output_files import input_file_name  # noqa: F401 - this module's name too
 
 
 def example_path(path: str, frame: int = 0) -> str:
@@ -37,8 +38,3 @@ def object_file_name(obj) -> str:
     """The object's name as it appears in file names (Blender's clean_name)."""
     return bpy.path.clean_name(obj.name)
 
-
-def input_file_name(path: str) -> str:
-    """An input file's name without extension as it appears in file names ('{input}'), cleaned
-    as object names are (object_file_name)."""
-    return bpy.path.clean_name(os.path.splitext(os.path.basename(path))[0])

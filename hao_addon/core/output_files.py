@@ -25,6 +25,24 @@ FRAME_TOKEN = "{frame}"
 FRAME_DIGITS = 4
 
 
+# The characters Blender's bpy.path.clean_name replaces with '_' (the same table in every
+# supported release): control characters, punctuation but '-' and '_', and Latin-1 but 0xff.
+_UNSAFE = [*range(0x00, 0x2d), 0x2e, 0x2f, *range(0x3a, 0x41), *range(0x5b, 0x5f), 0x60, *range(0x7b, 0xff)]
+_CLEAN = str.maketrans({code: "_" for code in _UNSAFE})
+
+
+def clean_name(name: str) -> str:
+    """A name as Blender cleans it for file names (bpy.path.clean_name), without bpy: a farm
+    job's writer loads no Blender."""
+    return name.translate(_CLEAN)
+
+
+def input_file_name(path: str) -> str:
+    """An input file's name without extension as it appears in file names ('{input}'),
+    cleaned as object names are."""
+    return clean_name(os.path.splitext(os.path.basename(path))[0])
+
+
 class OutputCollision(BakeInputError):
     """Two outputs on one file, or an output on an input file; parties: the two whats."""
 
