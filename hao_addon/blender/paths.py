@@ -2,8 +2,6 @@
 """Output paths as Blender users write them: '//' relative to the .blend file, '{object}'."""
 from __future__ import annotations
 
-import os
-
 import bpy
 
 from ..core.errors import BakeInputError
