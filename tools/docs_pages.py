@@ -43,6 +43,7 @@ TABLES = [("bake", "Bake settings", "The Bake AO panel, `bake`'s options and `Ba
 # Benchmarks in the report's order: (script stem, heading).
 BENCHES = [("bake_bench", "Bake: time against error, beside Cycles"),
            ("error_bench", "A bake's own error estimate, and baking to an error"),
+           ("floor_bench", "The error floor, against an independent truth"),
            ("cycles_error_bench", "Cycles' time to a stated error"),
            ("unwrap_bench", "Auto-unwrap"),
            ("hao_bench", "Viewport AO (HAO)"),

@@ -1,0 +1,126 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""An independent truth for bakes: exact ray-traced AO at each texel's sample point, traced by
+Embree (embreex), converged with tens of thousands of rays, its own noise measured from two
+seeds. It shares nothing with the bakers but the definitions (core/kernels.py's falloff, the
+texel centre as a texel's sample point): not their direction sets, not their rasterization,
+not the CPU reference's BVH.
+
+A texel's value is the AO at the surface point under its centre (core/bake/uv_raster.py):
+accessibility = 1 - E[rho(t)] over cosine-distributed directions about the normal (the face's,
+or the interpolated shading normal: then, as in Cycles' AO, a direction below the true face
+counts as occluded at distance 0), rays leaving the true surface.
+
+    from truth import texel_truth
+    truth = texel_truth(soup, occluders, size=256, rays=32768)   # truth.values (S, S), truth.noise
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from hao_addon.core.bake.uv_raster import texel_surface_samples  # noqa: E402
+from hao_addon.core.kernels import occlusion_weight  # noqa: E402
+
+# Rays leave p + n * OFFSET * (the baked mesh's radius): past float32 self-hits, far below a
+# texel (of the whole scene's radius, a 400-unit ceiling over a 2-unit floor lifted the floor
+# by 0.003 and the truth with it).
+OFFSET = 1e-5
+CHUNK_RAYS = 1 << 21
+
+
+@dataclass(frozen=True)
+class Truth:
+    """values: (S, S) accessibility at covered texel centres (0 elsewhere); covered: (S, S)
+    bool; noise: RMSE of the values' own Monte Carlo error (from the two seeds' halves)."""
+
+    values: np.ndarray
+    covered: np.ndarray
+    noise: float
+
+
+def texel_samples(soup, size: int, shading: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(covered (S, S), points (N, 3), shading normals (N, 3), face normals (N, 3)) of the
+    texel centres inside the soup's UV triangles."""
+    face, bary, _hits = texel_surface_samples(soup.uvs, size)
+    covered = face >= 0
+    faces, weights = face[covered], bary[covered]
+    corners = soup.positions[faces]
+    points = np.einsum("nk,nkj->nj", weights, corners)
+    geometric = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    geometric /= np.maximum(np.linalg.norm(geometric, axis=1, keepdims=True), 1e-300)
+    normals = geometric
+    if shading and soup.normals is not None:
+        normals = np.einsum("nk,nkj->nj", weights, soup.normals[faces])
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    return covered, points, normals, geometric
+
+
+def cosine_directions(normals: np.ndarray, rays: int, rng: np.random.Generator) -> np.ndarray:
+    """(N, R, 3): per point, R stratified cosine-weighted directions about its normal, the
+    strata rotated at random per point (independent between points)."""
+    side = int(np.sqrt(rays))
+    gy, gx = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
+    n = len(normals)
+    u = (gx.ravel()[None] + rng.random((n, side * side))) / side
+    v = (gy.ravel()[None] + rng.random((n, side * side))) / side
+    r, phi = np.sqrt(u), 2.0 * np.pi * v
+    helper = np.where(np.abs(normals[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t = np.cross(normals, helper)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    b = np.cross(normals, t)
+    return ((r * np.cos(phi))[..., None] * t[:, None] + (r * np.sin(phi))[..., None] * b[:, None]
+            + np.sqrt(1.0 - u)[..., None] * normals[:, None])
+
+
+def embree_scene(triangles: np.ndarray):
+    """An Embree scene of (F, 3, 3) triangles."""
+    from embreex import rtcore_scene
+    from embreex.mesh_construction import TriangleMesh
+    scene = rtcore_scene.EmbreeScene()
+    TriangleMesh(scene, np.ascontiguousarray(triangles, np.float32))
+    return scene
+
+
+def accessibility(scene, points: np.ndarray, normals: np.ndarray, geometric: np.ndarray, rays: int, seed: int,
+                  radius: float, max_distance: float = 0.0, falloff: str = "none") -> np.ndarray:
+    """(N,) AO at the points: 1 - the mean occlusion weight of `rays` cosine rays each."""
+    rng = np.random.default_rng(seed)
+    out = np.empty(len(points))
+    per = max(1, CHUNK_RAYS // rays)
+    for start in range(0, len(points), per):
+        sl = slice(start, start + per)
+        d = cosine_directions(normals[sl], rays, rng)
+        below = np.einsum("nrj,nj->nr", d, geometric[sl]) <= 0.0  # into the true surface: occluded
+        origin = points[sl] + geometric[sl] * (OFFSET * radius)
+        origins = np.broadcast_to(origin[:, None], d.shape).reshape(-1, 3)
+        hit = scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(d.reshape(-1, 3), np.float32),
+                        query="DISTANCE").reshape(d.shape[:2]).astype(np.float64)
+        hit = np.where(np.isfinite(hit) & (hit < 1e30), hit, np.inf)
+        weight = occlusion_weight(hit, max_distance, falloff)
+        weight = np.where(below, 1.0, weight)
+        out[sl] = 1.0 - weight.mean(axis=1)
+    return out
+
+
+def texel_truth(soup, occluders: list, size: int, rays: int = 32768, shading: bool = False,
+                max_distance: float = 0.0, falloff: str = "none", seed: int = 0) -> Truth:
+    """The truth of a bake of `soup` (with UVs) among `occluders` at size x size: `rays` rays
+    per texel centre, as two halves of independent seeds whose difference gives its noise."""
+    covered, points, normals, geometric = texel_samples(soup, size, shading)
+    triangles = np.concatenate([soup.positions] + [o.positions for o in occluders])
+    scene = embree_scene(triangles)
+    corners = soup.positions.reshape(-1, 3)
+    radius = float(np.linalg.norm(corners - corners.mean(axis=0), axis=1).max())
+    halves = [accessibility(scene, points, normals, geometric, rays // 2, seed * 2 + k, radius, max_distance,
+                            falloff) for k in range(2)]
+    values = np.zeros(covered.shape)
+    values[covered] = (halves[0] + halves[1]) / 2.0
+    noise = float(np.sqrt(np.mean(((halves[0] - halves[1]) / 2.0) ** 2))) if len(points) else 0.0
+    return Truth(values, covered, noise)
