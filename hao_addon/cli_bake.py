@@ -10,7 +10,7 @@ from pathlib import Path
 from .cli_errors import CLIError
 from .cli_io import check_signals, deferred_signals, Progress, REPORT, Report
 from .cli_options import option_for, settings_from_args
-from .cli_parser import IMAGE_OPTIONS, INPUT_FORMATS
+from .cli_parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
 from .cli_scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
                         export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
 from .core.frame_ranges import parse_frames
@@ -360,7 +360,7 @@ def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
     from .core.output_files import input_file_name
     name = input_file_name(path)
-    for option in ("out", *IMAGE_OPTIONS, "gltf_out"):
+    for option in ("out", *EXTRA_OUTPUT_OPTIONS):
         value = getattr(args, option)
         if value:
             setattr(args, option, value.replace(INPUT_TOKEN, name))

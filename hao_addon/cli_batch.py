@@ -10,14 +10,11 @@ from pathlib import Path
 from .cli_bake import fill_input_token, GLTF_OUT, has_token, image_outputs, run_bake, to_colors
 from .cli_errors import CLIError, failure
 from .cli_io import Progress, REPORT, Report, Terminated
-from .cli_parser import BATCH_NAME
+from .cli_parser import BATCH_NAME, EXTRA_OUTPUT_OPTIONS
 from .core.folders import nearest_existing, unmakeable_reason
 from .core.output_files import check_output_files, INPUT_TOKEN, OBJECT_TOKEN
 
 
-# The output options a batch resolves against --out-dir when they are relative (a farm task
-# runs in a scratch folder that its farm deletes afterwards: nothing may land there).
-BATCH_FILE_OPTIONS = ("bent_normal_out", "thickness_out", "orm_out", "error_out", "gltf_out")
 
 
 def batch_plan(args, folder: Path, template: str) -> tuple[list[argparse.Namespace], list[tuple[str, str]]]:
@@ -33,7 +30,7 @@ def batch_plan(args, folder: Path, template: str) -> tuple[list[argparse.Namespa
         sub = argparse.Namespace(**vars(args))
         sub.out = str(folder / template)
         fill_input_token(sub, path)
-        for option in BATCH_FILE_OPTIONS:
+        for option in EXTRA_OUTPUT_OPTIONS:  # relative: in --out-dir (a farm task's own folder is scratch)
             value = getattr(sub, option, "")
             if value and not os.path.isabs(value):
                 setattr(sub, option, str(folder / value))

@@ -126,10 +126,6 @@ def _absolute_if_file(value: str) -> str:
     return os.path.abspath(value) if Path(value).is_file() else value
 
 
-# The output options whose files a farm task writes into --out-dir (beside --out).
-EXTRA_OUTPUTS = ("bent_normal_out", "thickness_out", "orm_out", "error_out", "gltf_out")
-
-
 def run_farm(args, report: Report, progress) -> list[str]:
     if args.farm_command == "verify":
         return run_verify(args, report)
@@ -185,7 +181,8 @@ def _check_farm_outputs(args) -> None:
     paths) in it, never absolute and never above it (a task's own folder is the farm's
     scratch space, deleted after the task)."""
     from .cli_errors import CLIError
-    for option in EXTRA_OUTPUTS:
+    from .cli_parser import EXTRA_OUTPUT_OPTIONS
+    for option in EXTRA_OUTPUT_OPTIONS:
         value = getattr(args, option, "") or ""
         if value and (os.path.isabs(value) or ".." in Path(value).parts):
             flag = "--" + option.replace("_", "-")
@@ -197,10 +194,11 @@ def job_outputs(args, template: str) -> tuple[str, ...]:
     """The file names (templates, '{input}' unfilled) a task writes per input in the
     output folder: --out, then each map of --maps and each extra output option."""
     from .cli_bake import fill_map_outputs
+    from .cli_parser import EXTRA_OUTPUT_OPTIONS
     names = argparse.Namespace(**vars(args))
     names.out = template
     fill_map_outputs(names)
-    return (template, *(getattr(names, option) for option in EXTRA_OUTPUTS if getattr(names, option, "")))
+    return (template, *(getattr(names, option) for option in EXTRA_OUTPUT_OPTIONS if getattr(names, option, "")))
 
 
 def _check_collisions(args, template: str) -> None:
@@ -331,7 +329,7 @@ def run_verify(args, report: Report) -> list[str]:
     gives it, else (an '{object}' name, UDIM tiles) as the input's own task recorded it;
     every file must decode in full."""
     from .cli_errors import EXIT_FAILURE, CLIError
-    from .core.imageio import output_is_whole
+    from .core.file_checks import output_is_whole
     manifest = read_manifest(args.manifest)
     out_dir = os.path.abspath(args.out_dir)
     written = receipts(manifest, out_dir)

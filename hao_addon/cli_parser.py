@@ -66,6 +66,8 @@ MAP_OUTPUTS = {"ao": "", "bent-normal": "bent_normal_out", "thickness": "thickne
                "error": "error_out"}
 # The image options besides --out (each an image bake: not with a colour attribute).
 IMAGE_OPTIONS = tuple(option for option in MAP_OUTPUTS.values() if option)
+# Every output option besides --out and --json: the maps' and the glTF file.
+EXTRA_OUTPUT_OPTIONS = (*IMAGE_OPTIONS, "gltf_out")
 
 
 def add_bake_arguments(b: argparse.ArgumentParser) -> None:

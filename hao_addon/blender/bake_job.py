@@ -26,8 +26,8 @@ from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
 from ..core.steps import relay
 from ..core.bake.error_estimate import estimate
 from ..verify import verify_steps
-from ..core.imageio import (BAKE_KEY, FORMATS, StagedFiles, check_writable, image_is_whole, output_is_whole,
-                            read_text)
+from ..core.file_checks import image_is_whole, output_is_whole
+from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
 from ..core.output_files import check_output_files, frame_file, with_token
 from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
