@@ -89,17 +89,29 @@ def embree_scene(triangles: np.ndarray):
 
 
 def accessibility(scene, points: np.ndarray, normals: np.ndarray, geometric: np.ndarray, rays: int, seed: int,
-                  radius: float, max_distance: float = 0.0, falloff: str = "none") -> np.ndarray:
-    """(N,) AO at the points: 1 - the mean occlusion weight of `rays` cosine rays each."""
+                  radius: float, max_distance: float = 0.0, falloff: str = "none", lift: np.ndarray | None = None,
+                  terminator_offset: float = 0.0) -> np.ndarray:
+    """(N,) AO at the points: 1 - the mean occlusion weight of `rays` cosine rays each.
+    lift: (N, 3) Cycles' terminator lift of each point at full amount (world units), with
+    terminator_offset its cut-off: a ray starts lifted by lift_amount (core/bake/terminator.py,
+    the definition the bakes share), and a ray below the face that is lifted is traced
+    instead of counted occluded."""
+    from hao_addon.core.bake.terminator import lift_amount
     rng = np.random.default_rng(seed)
     out = np.empty(len(points))
     per = max(1, CHUNK_RAYS // rays)
     for start in range(0, len(points), per):
         sl = slice(start, start + per)
         d = cosine_directions(normals[sl], rays, rng)
-        below = np.einsum("nrj,nj->nr", d, geometric[sl]) <= 0.0  # into the true surface: occluded
-        origin = points[sl] + geometric[sl] * (OFFSET * radius)
-        origins = np.broadcast_to(origin[:, None], d.shape).reshape(-1, 3)
+        cos_true = np.einsum("nrj,nj->nr", d, geometric[sl])
+        below = cos_true <= 0.0  # into the true surface: occluded
+        origins = np.broadcast_to((points[sl] + geometric[sl] * (OFFSET * radius))[:, None], d.shape)
+        if lift is not None and terminator_offset > 0.0:
+            amount = lift_amount(np.einsum("nrj,nj->nr", d, normals[sl]), cos_true, terminator_offset)
+            lifted = amount * np.linalg.norm(lift[sl], axis=1)[:, None] > OFFSET * radius
+            origins = np.where(lifted[..., None], points[sl][:, None] + lift[sl][:, None] * amount[..., None], origins)
+            below &= ~lifted
+        origins = origins.reshape(-1, 3)
         hit = scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(d.reshape(-1, 3), np.float32),
                         query="DISTANCE").reshape(d.shape[:2]).astype(np.float64)
         hit = np.where(np.isfinite(hit) & (hit < 1e30), hit, np.inf)
@@ -114,12 +126,66 @@ def texel_truth(soup, occluders: list, size: int, rays: int = 32768, shading: bo
     """The truth of a bake of `soup` (with UVs) among `occluders` at size x size: `rays` rays
     per texel centre, as two halves of independent seeds whose difference gives its noise."""
     covered, points, normals, geometric = texel_samples(soup, size, shading)
-    triangles = np.concatenate([soup.positions] + [o.positions for o in occluders])
-    scene = embree_scene(triangles)
+    return truth_at(soup, occluders, (covered, points, normals, geometric, None, 0.0), rays, max_distance, falloff,
+                    seed)
+
+
+def reference_sample_points(soup, settings) -> tuple:
+    """bake_sample_points' tuple for the reference bake of `soup` with `settings`: its
+    receivers are the CPU raster's texel centres (plan.receivers(), as texel_samples)."""
+    from dataclasses import replace
+    from hao_addon.core.bake.plan import make_plan_steps
+    from hao_addon.core.bake.targets import as_bake_target
+    from hao_addon.core.steps import drain
+    plan = drain(make_plan_steps(as_bake_target(soup, "image", None, None), [],
+                                 replace(settings, method="reference", directions=4)))
+    return _samples_of(plan.receivers(), plan, settings)
+
+
+def _samples_of(receivers, plan, settings) -> tuple:
+    """One receiver per texel (overlapping UV islands: one entry's), in texel order, in world units."""
+    receivers = receivers.subset(receivers.inv_s > 0.0)
+    _unique, first = np.unique(receivers.texel, return_index=True)
+    receivers = receivers.subset(first)
+    covered = np.zeros(settings.size ** 2, bool)
+    covered[receivers.texel] = True
+    lift = None if receivers.lift is None else receivers.lift * plan.scale
+    return (covered.reshape(settings.size, settings.size), receivers.points * plan.scale + plan.centre,
+            receivers.shading, receivers.geometric, lift, settings.terminator_offset if lift is not None else 0.0)
+
+
+def bake_sample_points(soup, settings) -> tuple:
+    """(covered (S, S), points (N, 3), shading normals (N, 3), face normals (N, 3), terminator
+    lift (N, 3) or None, terminator offset) of the
+    points where a gather bake of `soup` with `settings` samples each texel: its GPU texel
+    list read back (the texel centre on the face its rasterizer picked; on a UV edge shared by
+    two faces that may be the other face than texel_samples' CPU raster picks, and with flat
+    normals the two give other values: both are the AO at a point of the surface). The matching
+    truth of a gather map is traced at these. Needs a GPU context."""
+    from dataclasses import replace
+    from hao_addon.core.bake.plan import make_plan_steps
+    from hao_addon.core.bake.targets import as_bake_target
+    from hao_addon.core.steps import drain
+    from hao_addon.gpu.bake_gather import GatherBaker
+    plan = drain(make_plan_steps(as_bake_target(soup, "image", None, None), [], replace(settings, directions=4)))
+    baker = GatherBaker(plan)
+    try:
+        receivers = baker.sample_receivers(np.arange(settings.size ** 2))
+    finally:
+        baker.free()
+    return _samples_of(receivers, plan, settings)
+
+
+def truth_at(soup, occluders: list, samples, rays: int = 32768, max_distance: float = 0.0, falloff: str = "none",
+             seed: int = 0) -> Truth:
+    """texel_truth at given samples (covered, points, shading normals, face normals, terminator
+    lift or None, terminator offset), such as bake_sample_points'."""
+    covered, points, normals, geometric, lift, terminator_offset = samples
+    scene = embree_scene(np.concatenate([soup.positions] + [o.positions for o in occluders]))
     corners = soup.positions.reshape(-1, 3)
     radius = float(np.linalg.norm(corners - corners.mean(axis=0), axis=1).max())
     halves = [accessibility(scene, points, normals, geometric, rays // 2, seed * 2 + k, radius, max_distance,
-                            falloff) for k in range(2)]
+                            falloff, lift, terminator_offset) for k in range(2)]
     values = np.zeros(covered.shape)
     values[covered] = (halves[0] + halves[1]) / 2.0
     noise = float(np.sqrt(np.mean(((halves[0] - halves[1]) / 2.0) ** 2))) if len(points) else 0.0
