@@ -25,10 +25,11 @@ from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
-    replicate_twin
-from .core.directions import replicate_sizes
+    replicate_twin, with_floor, directions_for
+from .floor_check import floor_sample, floor_steps, probe_steps, take_probe
+from .replicates import replicate_sums_steps
 from .core.bake.seams import dilate, element_values, finalize_map, finalize_vectors
-from .core.bake.settings import BakeSettings
+from .core.bake.settings import QUALITY_CAPS, BakeSettings
 from .core.bake.abilities import check_method, choose_method, declaration
 from .core.bake.targets import BakeTarget, as_bake_target
 from .core.bake.vertex_target import VertexTarget
@@ -70,6 +71,14 @@ class BakeResult:
 # twins; an honest choice needs a contrast the report does not use, a third replicate
 # (1.2-1.3x the map's noise at equal directions).
 SKIP_CONVERGED = False
+
+# The share of a GPU bake's progress bar that measuring its visibility floor fills (a few
+# percent of its time: hao_addon/floor_check.py).
+FLOOR_PROGRESS_SHARE = 0.05
+
+# A bake to an error whose visibility floor has a p99 above this share of its target stops
+# adding directions: they cannot bring it there (the report says so, and what to raise).
+FLOOR_REACH = 0.9
 
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
 # the bunny pair at 1024^2: 2.8 s of 7.8 s at 256 directions, of 22 s at 1024).
@@ -147,10 +156,18 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
         return replace(cached, stats=stats)
     # numpy's BLAS workers would spin on the cores the GPU driver needs (core/blas_threads.py).
     with single_threaded_blas() as blas_threads:
+        # The floor check samples more texels for bakes of more directions (floor_texel_count).
+        shared: dict = {"floor_directions": settings.direction_cap if settings.error_target > 0.0
+                        else settings.directions}
+        checked = not declaration(settings.method_for(target.high_to_low is not None)).floor_unchecked
+        share = FLOOR_PROGRESS_SHARE if checked else 0.0
         if settings.error_target > 0.0:
-            result = yield from _bake_to_error(target, occluders, settings)
+            baking = _bake_to_error(target, occluders, settings, shared)
         else:
-            result = yield from _bake_uncached(target, occluders, settings)
+            baking = _bake_uncached(target, occluders, settings, shared)
+        result = yield from relay(baking, lambda fraction: (1.0 - share) * fraction)
+        result = yield from relay(_with_floor_steps(result, shared, settings, target.name),
+                                  lambda fraction: 1.0 - share + share * fraction)
     result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
                         target_name=target.name)
     directions = result.error.directions if result.error is not None else settings.directions
@@ -207,10 +224,17 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     baker = baker_cls(plan)
     try:
         count = settings.directions
-        sums_a, sums_b = yield from replicate_sums_steps(baker, count, share)
+        best = shared["floor_probe"].half if shared.get("floor_probe") else 0
+        snapshots = probe_steps(method, count, best)
+        sums_a, sums_b = yield from replicate_sums_steps(baker, count, share, snapshots)
         # The map is the replicates' mean (each receiver weighs 1 in each).
         sums = sums_b if sums_a is None else sums_a + sums_b
         gpu_stats = dict(baker.stats)
+        if "floor_sample" not in shared:  # the first round's sample points serve every round
+            shared["floor_sample"] = floor_sample(method, plan.estimator.ratio(sums)[1] > 0.0, baker,
+                                                  shared.get("floor_directions", count), settings.seed)
+        if snapshots is not None and shared["floor_sample"] is not None:
+            shared["floor_probe"] = take_probe(plan, baker, count, snapshots, shared["floor_sample"][0])
     finally:
         baker.free()
     # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py), or
@@ -243,32 +267,21 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error)
 
 
-def replicate_sums_steps(baker, count: int, start: float = 0.0) -> Generator[float, None, tuple]:
-    """Run a baker's `count` directions, each replicate summed apart (core/bake/error_estimate.py):
-    (the first replicate's sums or None when there is one, the last one's), each
-    (*plan.output_shape, channels). Yields progress from start to 1."""
-    split = replicate_sizes(count)[0]  # the second replicate's first direction
-    sums_a = None
-    for i in range(count):
-        if i == split:
-            sums_a = baker.accumulated()
-            baker.restart()
-        baker.run_direction(i)
-        yield start + (1.0 - start) * (i + 1) / count
-    return sums_a, baker.accumulated()
-
-
-def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings
+def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, shared: dict
                    ) -> Generator[float, None, BakeResult]:
     """Rounds of whole bakes, each with its own direction set, until the estimated p99 of their
-    union is within settings.error_target or settings.directions are spent (capped). Each
+    union is within settings.error_target or settings.direction_cap is spent (capped). Each
     round's size is predicted from the error so far (core/bake/error_estimate.next_round).
+    When the twins reach the target, the visibility floor is measured (hao_addon/floor_check.py);
+    where it keeps the whole error above the target but is itself below FLOOR_REACH of it, the
+    twins' target is lowered to leave room for it (p99s added in quadrature) and rounds go on.
     Each texel is the mean of the rounds that baked it, weighted by their directions, and so is
     its twin (independent rounds: still a draw of its error). Every round bakes every texel
     (SKIP_CONVERGED); stats' skippable_fraction is the share of texel directions that
     leaving converged texels out would have saved."""
-    target_error, cap = settings.error_target, settings.directions
-    rounds, history, shared = [], [], {}
+    target_error, cap = settings.error_target, settings.direction_cap
+    stat_target, floor_seen = target_error, False
+    rounds, history = [], []
     work = skipped = 0.0  # texel x direction pairs: all of them, and those left out
     size, done, shown, cells, skips = min(cap, PILOT_DIRECTIONS), 0, 0.0, None, True
     while size > 0:
@@ -287,13 +300,20 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         if combined.error is None:
             break
         history.append((done, combined.error.p99))
-        size = next_round(history, target_error, cap)
+        size = next_round(history, stat_target, cap)
+        if not size and not floor_seen and done < cap:
+            floor_seen = True
+            whole = yield from relay(_with_floor_steps(combined, shared, settings, target.name), lambda f: shown)
+            floor_p99 = whole.error.floor_p99
+            if whole.error.p99 > target_error and floor_p99 < FLOOR_REACH * target_error:
+                stat_target = target_error * math.sqrt(1.0 - (floor_p99 / target_error) ** 2)
+                size = next_round(history, stat_target, cap)
         if size:  # the texels the next round needs: those not yet converged (all if none is)
             active = combined.covered & ~converged(combined.twin, combined.covered, target_error)
             cells = np.flatnonzero(active) if active.any() else None
             work += size * float(combined.covered.sum())
             skipped += size * float(combined.covered.sum() - active.sum())
-    capped = combined.error is not None and combined.error.p99 > target_error
+    capped = combined.error is not None and combined.error.p99 > stat_target
     error = None if combined.error is None else replace(combined.error, capped=capped)
     method = rounds[0][1].stats["method"]
     stats = {**combined.stats, "error": None if error is None else error.as_dict(), "error_target": target_error,
@@ -301,10 +321,41 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
              "skipped_converged": SKIP_CONVERGED and skips and skipped > 0.0,
              **({"bakes_all_cells": declaration(method).bakes_all_cells} if not skips else {})}
     if capped:
+        needed = directions_for(error.p99, done, target_error)
+        stats["directions_needed"] = int(math.ceil(needed))
         stats["warnings"] = [*stats.get("warnings", []),
                              f"'{target.name}': the estimated p99 error {error.p99:.2g} is above the target "
-                             f"{target_error:.2g} after {done} directions (the cap, Directions); raise Directions"]
+                             f"{target_error:.2g} after {done} directions (the cap); by the measured rate it needs "
+                             f"about {needed:.3g} directions"
+                             + ("" if settings.quality in QUALITY_CAPS else ": raise Directions")]
     return replace(combined, stats=stats, error=error)
+
+
+def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, name: str
+                      ) -> Generator[float, None, BakeResult]:
+    """result with its stated error made whole: the visibility floor measured at sampled
+    texels (hao_addon/floor_check.py) added to the twins' estimate, and a warning where that
+    puts a bake to an error above its target."""
+    if result.error is None or result.twin is None or shared.get("floor_probe") is None:
+        return result
+    probe = shared["floor_probe"]
+    if shared.get("floor_found", (None,))[0] is not probe:  # a bake to an error measures it once per probe
+        shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"])))
+    found = shared["floor_found"][1]
+    if found is None:
+        return result
+    cells, floor_a, floor_b = found
+    error = with_floor(result.error, floor_a, floor_b, result.error_map().reshape(-1)[cells])
+    stats = {**result.stats, "error": error.as_dict()}
+    target = settings.error_target
+    if target > 0.0 and error.p99 > target and not error.capped:
+        why = (f"its visibility floor ({error.floor_p99:.2g} p99) does not fall with directions; raise View "
+               f"Samples or bake with the reference" if error.floor_p99 >= FLOOR_REACH * target else
+               f"with its visibility floor ({error.floor_p99:.2g} p99) it landed above; raise the target or "
+               f"bake again with a larger Quality")
+        stats["warnings"] = [*stats.get("warnings", []),
+                             f"'{name}': the p99 error {error.p99:.2g} is above the target {target:.2g}: {why}"]
+    return replace(result, error=error, stats=stats)
 
 
 def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeResult:

@@ -9,7 +9,8 @@ from typing import Generator
 
 import numpy as np
 
-from .bake import BakeResult, replicate_sums_steps
+from .bake import BakeResult
+from .replicates import replicate_sums_steps
 from .core.bake.error_estimate import replicate_twin
 from .core.bake.plan import make_plan_steps
 from .core.bake.reference_baker import ReferenceBaker

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import bpy
 
+from ..hao_addon.core.bake.settings import QUALITY_CAPS
+
 
 class VIEW3D_PT_hao_bake(bpy.types.Panel):
     """Bake per-texel ambient occlusion on the GPU"""
@@ -22,7 +24,10 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col = layout.column()
         col.prop(settings, "size")
         col.prop(settings, "quality")
-        col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
+        if settings.quality in QUALITY_CAPS:  # a preset caps itself
+            col.label(text=f"Up to {QUALITY_CAPS[settings.quality]} directions")
+        else:
+            col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
         sub = col.column()
         sub.active = settings.quality in ("custom", "fixed")
         sub.prop(settings, "max_error")

@@ -23,7 +23,7 @@ from hao_addon.core import scenes
 from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.bake import error_estimate as ee
 from hao_addon.core.bake.abilities import bakers_with
-from hao_addon.core.bake.settings import BakeSettings, QUALITY_ERRORS
+from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.directions import bake_directions, replicate_sizes
 
 ROOT = cases.ROOT
@@ -147,15 +147,17 @@ def test_estimate_matches_the_error_against_cycles_and_a_converged_bake(gpu_cont
 
 
 def test_bake_to_a_stated_error_meets_it_and_stops_at_its_cap(gpu_context):
-    """Quality 'draft' (p99 0.01) on Spot: rounds until the estimate is there, and the map's
-    p99 against the converged bake meets it; a cap below what is needed stops there, says
-    so, and warns."""
+    """A p99 of 0.015 on Spot at 256^2: rounds until the whole estimate (the twins and the
+    visibility floor, whose p99 is about 0.009-0.010 here, which leaves the twins about 0.011)
+    is there, and the map's p99 against the converged bake meets it; a cap below what is
+    needed stops there, says so, and warns. (Draft's 0.01 is at this size's floor: such a bake
+    stops at once and says the floor is what keeps it above: tests/test_whole_error.py.)"""
     name = "spot_smooth"
     soup, _cycles, _var, inner = _smooth_case(name)
     high = [_gather(soup, name, 4096, seed=s) for s in (7, 8)]
     converged = 0.5 * (high[0].ao.astype(np.float64) + high[1].ao)
-    res = _gather(soup, name, 8192, quality="draft")
-    target = QUALITY_ERRORS["draft"]
+    target = 0.015
+    res = _gather(soup, name, 8192, quality="custom", max_error=target)
     st = res.stats
     assert len(st["rounds"]) >= 2 and st["rounds"][0] == ee.PILOT_DIRECTIONS and sum(st["rounds"]) < 8192
     assert st["error"] == res.error.as_dict() and res.error.p99 <= target and not res.error.capped
@@ -179,9 +181,11 @@ def test_cli_reports_the_error_and_writes_the_error_map(tmp_path):
     assert run.returncode == 0, run.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     error = report["objects"][0]["error"]
-    assert set(error) == {"rmse", "p99", "directions", "capped"} and error["directions"] == 64
+    assert set(error) == {"rmse", "p99", "directions", "capped", "floor_rmse", "floor_p99", "floor_texels"}
+    assert error["directions"] == 64 and error["floor_texels"] > 0
     assert 0.0 < error["rmse"] < error["p99"] < 0.2 and error["capped"] is False
-    assert f"error ~{error['rmse']:.2g} RMSE, {error['p99']:.2g} p99 (64 directions)" in run.stdout
+    assert (f"error ~{error['rmse']:.2g} RMSE, {error['p99']:.2g} p99 (64 directions; visibility floor "
+            f"{error['floor_rmse']:.2g} RMSE)") in run.stdout
     assert str(tmp_path / "err.exr") in report["outputs"]
     from bake_helpers import load_image_rgba
     err = load_image_rgba(tmp_path / "err.exr")[..., 0]
@@ -231,7 +235,16 @@ def test_every_target_bakes_to_a_stated_error(gpu_context, monkeypatch, target, 
         settings = replace(settings, max_ray_distance=0.05)
     res = bake(receiver, occluders, settings, use_cache=False, **kwargs)
     st = res.stats
-    assert len(st["rounds"]) >= 2 and not res.error.capped and res.error.p99 <= 0.03, st["rounds"]
+    assert len(st["rounds"]) >= 2 and not res.error.capped, st["rounds"]
+    assert (res.error.floor_texels > 0) == (method == "gather")  # the scatter's and the reference's are not measured
+    if target == "projected":
+        # The gather misses the contact shadow under the ball that the high-poly points on its
+        # underside get from the floor (closer than its depth slack): the floor check finds it,
+        # so the stated error is above the target, and the bake says why.
+        assert res.error.floor_p99 > 0.005 and res.error.p99 > 0.03
+        assert any("visibility floor" in w for w in st["warnings"])
+    else:
+        assert res.error.p99 <= 0.03
     assert res.twin.shape == res.ao.shape and res.error.directions == sum(st["rounds"])
     if target == "udim":
         assert res.tiles == (1001, 1002)

@@ -55,6 +55,37 @@ def replicate_sizes(count: int) -> list[int]:
     return [count // k + (r < count % k) for r in range(k)]
 
 
+# A GPU bake's floor probe (hao_addon/floor_check.py): each replicate's first probe_half()
+# directions, a random subset of it, are baked first, so that its partial sums after them are
+# a map of its own: a quarter of the bake's directions, at least PROBE_MIN and at most
+# PROBE_MAX per replicate (the probe's own direction noise falls as 1/sqrt of its size, and
+# the floor's estimate with it: at 256 per replicate one texel of Spot's 1024 could swing it
+# from 0.0024 to 0.0003; the reference's rays grow with it).
+PROBE_MIN = 128
+PROBE_MAX = 1024
+
+
+def probe_half(count: int) -> int:
+    """Directions per replicate of the floor probe of a bake of `count` directions."""
+    return min(replicate_sizes(count)[-1], int(np.clip(count // 4, PROBE_MIN, PROBE_MAX)))
+
+
+def probe_first(count: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """(probe, rest): sorted indices into a replicate of `count` directions, a probe of
+    min(half, count) of them drawn at random (seeded by count and half), and the others.
+
+    Why at random: under the replicate's random rotation any subset is unbiased, but the
+    probe's value at a texel is a ratio (its directions' weighted visibility over their
+    weights), and a structured subset's weight sum swings with the rotation. Every 4th point of
+    a spherical Fibonacci set steps its azimuth by 4/golden ratio, almost half a turn: two
+    meridians' worth of points, whose ratio overstated the floor by 1.7x (Spot at 128^2). A
+    random subset's weight sum varies as little as any random set's."""
+    half = min(half, count)
+    probe = np.sort(np.random.default_rng([count, half]).permutation(count)[:half])
+    rest = np.setdiff1d(np.arange(count), probe)
+    return probe, rest
+
+
 def bake_directions(count: int, seed: int = 0) -> np.ndarray:
     """The baker's direction set: REPLICATES spherical Fibonacci sets, each with its own
     random rotation (replicate_sizes, one after the other).

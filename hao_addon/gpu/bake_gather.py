@@ -30,9 +30,9 @@ import numpy as np
 
 from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
-                                     normal_bins, octahedral_coords, proximity_order)
+                                     normal_bins, octahedral_coords, octahedral_decode, proximity_order)
 from ..core.errors import BakeInputError
-from ..core.directions import replicate_sizes
+from ..core.directions import probe_first, probe_half, replicate_sizes
 from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
@@ -303,10 +303,14 @@ class GatherBaker(LightViewBaker):
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
         # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py),
-        # each replicate in its own order, one after the other (they are accumulated apart).
+        # each replicate in its own order, one after the other (they are accumulated apart), its
+        # floor probe's directions first (core/directions.probe_first).
         starts = np.cumsum([0, *replicate_sizes(len(plan.directions))])
-        self.direction_order = np.concatenate([a + proximity_order(plan.directions[a:b])
-                                               for a, b in zip(starts[:-1], starts[1:])])
+        half, order = probe_half(len(plan.directions)), []
+        for a, b in zip(starts[:-1], starts[1:]):
+            for part in probe_first(b - a, half):
+                order.append(a + part[proximity_order(plan.directions[a + part])])
+        self.direction_order = np.concatenate(order)
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
@@ -464,6 +468,28 @@ class GatherBaker(LightViewBaker):
         else:
             needed = np.ones(BIN_COUNT, bool)
         return bin_runs(needed, self.bin_first)
+
+    def sample_receivers(self, cells: np.ndarray) -> Receivers:
+        """The list's receivers at `cells` (flat texel indices): this bake's own sample points,
+        where its rasterizer put them (on a UV edge shared by two faces it may pick the other
+        face than the CPU's raster, core/bake/uv_raster.py; both are points of the surface)."""
+        if self.receivers is not None:
+            receivers = self.receivers.subset(self.receivers.inv_s > 0.0)
+            return receivers.subset(np.isin(receivers.texel, cells))
+        n, size = self.entry_count, self.plan.settings.size
+        texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n]
+        flat = (texel >> 16).astype(np.int64) * size + (texel & 0xFFFF)
+        keep = np.isin(flat, cells)
+        position = util.texture_to_numpy(self.entry_position, np.float32).reshape(-1, 4)[:n][keep].astype(np.float64)
+        normal = util.texture_to_numpy(self.entry_normal, np.float32).reshape(-1, 4)[:n][keep].astype(np.float64)
+        if self.shading_layout:
+            shading, geometric = octahedral_decode(normal[:, :2]), octahedral_decode(normal[:, 2:])
+        else:
+            shading = geometric = normal[:, :3]
+        lift = None
+        if self.lifted:
+            lift = util.texture_to_numpy(self.entry_lift, np.float32).reshape(-1, 4)[:n][keep, :3].astype(np.float64)
+        return Receivers(position[:, :3], geometric, shading, position[:, 3], flat[keep], lift)
 
     def restart(self) -> None:
         """Zero the sums (after accumulated()): the next directions are summed apart."""

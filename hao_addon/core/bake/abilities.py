@@ -50,7 +50,8 @@ class BakerDeclaration:
     baker can bake it (the benchmark's fastest at equal error); an empty set is the fallback.
     bakes_all_cells: why the baker bakes every texel of its target even when a plan names the
     cells still needed (BakePlan.cells: the later rounds of a bake to an error); '' when it
-    bakes only those."""
+    bakes only those. floor_unchecked: why the bake's visibility floor is not measured
+    (hao_addon/floor_check.py: exact rays at sampled texels along its own directions); '' when it is."""
 
     method: str
     label: str
@@ -58,6 +59,7 @@ class BakerDeclaration:
     cannot: Mapping[str, str] = field(default_factory=dict)
     auto_for: frozenset[str] = frozenset()
     bakes_all_cells: str = ""
+    floor_unchecked: str = ""
 
     def can(self, ability: str) -> bool:
         return ability not in self.cannot
@@ -75,12 +77,14 @@ BAKERS = (
                 "bent-normals": "its accumulator packs ambient occlusion's two sums in one word",
                 "udim": "it rasterizes one 0..1 UV tile",
                 "color-attribute": "it rasterizes the UV layout"},
-        bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
+        bakes_all_cells="it splats every texel its target's triangles cover in each light view",
+        floor_unchecked="its texels are averages over their area, which the reference's point samples do not match"),
     BakerDeclaration(
         "gather", "shadow-map gather", gpu=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "
                              "walls: 0.006 too thin on a ball, measured by tests/test_thickness.py"}),
-    BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False),
+    BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False,
+                     floor_unchecked="its visibility is exact: rays against the triangles"),
 )
 BAKE_METHODS = tuple(b.method for b in BAKERS)
 _BY_METHOD = {b.method: b for b in BAKERS}

@@ -22,14 +22,18 @@ do: their errors are negatively correlated (the whole set is better than either 
 halves' spread overstated the error (by about 40 % at 256 directions on the rocker arm).
 
 What the twins do not show: the error every direction count shares (shadow-map resolution,
-texel sampling), which more directions never remove; the verification (--verify) measures it.
+texel sampling), which more directions never remove. A GPU bake therefore also measures that
+part, its visibility floor (hao_addon/floor_check.py): at sampled texels, the CPU reference's
+exact rays along the bake's own directions, against the map. With the same directions the
+difference holds no direction noise, only what the visibility test gets wrong, and
+with_floor() adds it to the twins' estimate: the stated error is the whole error.
 A single texel's twin is one draw, so the error image is the twins' RMS over each texel's
 neighbourhood (local_rms), and per-texel convergence is judged from that (converged).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -59,14 +63,20 @@ class ErrorEstimate:
     p99: float
     directions: int
     capped: bool = False
+    # The visibility floor in it (with_floor): its RMSE and p99 at floor_texels sampled texels
+    # (0 texels: not measured, as for the reference, whose visibility is exact).
+    floor_rmse: float = 0.0
+    floor_p99: float = 0.0
+    floor_texels: int = 0
 
     def as_dict(self) -> dict:
         return asdict(self)
 
     def text(self) -> str:
         """'error ~0.0042 RMSE, 0.011 p99 (256 directions)' for summary lines and reports."""
+        floor = f"; visibility floor {self.floor_rmse:.2g} RMSE" if self.floor_texels else ""
         return (f"error ~{self.rmse:.2g} RMSE, {self.p99:.2g} p99 ({self.directions} directions"
-                f"{', capped' if self.capped else ''})")
+                f"{', capped' if self.capped else ''}{floor})")
 
 
 def replicate_twin(numerator_a: np.ndarray, weight_a: np.ndarray, numerator_b: np.ndarray, weight_b: np.ndarray
@@ -87,6 +97,55 @@ def estimate(twin: np.ndarray, covered: np.ndarray, directions: int, capped: boo
         return None
     return ErrorEstimate(float(np.sqrt((values * values).mean())), float(np.percentile(values, 99)), int(directions),
                          capped)
+
+
+# with_floor's p99: each sampled texel's error drawn at these standard normal quantiles.
+FLOOR_QUANTILES = 64
+
+
+def with_floor(error: ErrorEstimate, floor_a: np.ndarray, floor_b: np.ndarray, sigma: np.ndarray) -> ErrorEstimate:
+    """The whole error: `error` (the twins') with the visibility floor measured at sampled
+    texels. floor_a, floor_b: (n,) each replicate's value there minus the exact value along its
+    own directions (hao_addon/floor_check.py); sigma: (n,) the twins' local RMS there (the
+    direction noise each texel has on top).
+
+    The floor proper is the part of floor_a and floor_b that their independent rotations share:
+    its mean square is the mean of floor_a * floor_b (the parts that change with the rotation
+    are in the twins already, and counting them again overstated Spot's error at 256
+    directions by 1.2x). RMSE: the floor and the noise are independent, so their squares add.
+    p99: each texel's error is its floor (the replicates' mean, scaled to the floor proper's
+    RMS) plus its noise; the sampled texels' errors at FLOOR_QUANTILES normal quantiles of their
+    noise give the p99 with and without the floor, and the twins' p99 (over every texel) is
+    scaled by their ratio."""
+    floor_a, floor_b = np.asarray(floor_a, np.float64), np.asarray(floor_b, np.float64)
+    if floor_a.size == 0:
+        return error
+    square = max(float(np.mean(floor_a * floor_b)), 0.0)
+    floor = 0.5 * (floor_a + floor_b)
+    mean_square = float(np.mean(floor ** 2))
+    floor = floor * (np.sqrt(square / mean_square) if mean_square > 0.0 else 0.0)
+    sigma = np.asarray(sigma, np.float64)
+    z = _normal_quantiles(FLOOR_QUANTILES)
+    with_it = np.percentile(np.abs(floor[:, None] + sigma[:, None] * z[None]), 99)
+    without = np.percentile(np.abs(sigma[:, None] * z[None]), 99)
+    p99 = error.p99 * with_it / without if without > 0.0 else max(error.p99, with_it)
+    return replace(error, rmse=float(np.sqrt(error.rmse ** 2 + square)), p99=float(max(p99, error.p99)),
+                   floor_rmse=float(np.sqrt(square)), floor_p99=float(np.percentile(np.abs(floor), 99)),
+                   floor_texels=int(floor.size))
+
+
+def _normal_quantiles(count: int) -> np.ndarray:
+    """(count,) the standard normal's quantiles at (k + 1/2) / count, by bisection of math.erf
+    (numpy has no inverse of it)."""
+    targets = (np.arange(count) + 0.5) / count
+    out = np.empty(count)
+    for k, t in enumerate(targets):
+        lo, hi = -10.0, 10.0
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if 0.5 * (1.0 + math.erf(mid / math.sqrt(2.0))) < t else (lo, mid)
+        out[k] = 0.5 * (lo + hi)
+    return out
 
 
 def _box_sum(values: np.ndarray, radius: int) -> np.ndarray:

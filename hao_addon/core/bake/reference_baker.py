@@ -28,6 +28,7 @@ from .terminator import lift_amount
 from ..reference import build_bvh, first_hits, hits_along, ray_offset
 from .alpha import expected_visibility
 from .projection import barycentric
+from .receivers import Receivers
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
 # minutes, which nobody asks for by accident.
@@ -62,9 +63,12 @@ class ReferenceBaker:
                 f"(size^2 x samples per texel x directions), "
                 f"more than its limit of {MAX_REFERENCE_RAYS:,}; use a smaller map, fewer directions or a GPU method")
 
-    def __init__(self, plan: BakePlan) -> None:
+    def __init__(self, plan: BakePlan, receivers: Receivers | None = None, min_offset: float = 0.0) -> None:
+        """receivers: trace from these instead of the plan's (a GPU bake's own sample points,
+        hao_addon/floor_check.py); min_offset: rays start at least this far off the surface
+        (normalized units; float32 points off their face need more than ray_offset)."""
         self.plan = plan
-        receivers = plan.receivers()  # plan.cells' alone where it names them
+        receivers = plan.receivers() if receivers is None else receivers  # plan.cells' alone where it names them
         receivers = receivers.subset(receivers.inv_s > 0.0)
         self.texel = receivers.texel
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
@@ -75,7 +79,7 @@ class ReferenceBaker:
         self.face_normals = plan.drawn_normals.astype(np.float64) if plan.settings.ignore_back_faces else None
         flat = scene.reshape(-1, 3)
         radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
-        self.offsets = np.array([ray_offset(p, radius) for p in self.points])
+        self.offsets = np.array([max(ray_offset(p, radius), min_offset) for p in self.points])
         self.origins = [Vector(p) for p in self.points + self.geometric * self.offsets[:, None]]
         self.lift = receivers.lift
         self.estimator = plan.estimator

@@ -65,6 +65,10 @@ QUALITY_CHOICES = (
 )
 # The p99 error each Quality bakes to (0: none, Directions decide).
 QUALITY_ERRORS = {"fixed": 0.0, "draft": 0.01, "8-bit": 0.5 / 255.0, "16-bit": 0.125 / 255.0, "custom": None}
+# The presets' own caps on directions, in place of Directions (which caps Custom and Max
+# Error): enough to reach their targets on every mesh of bench/ (bench/error_bench.py: 8-bit
+# took up to 12k directions at 1024^2 and the 16-bit target's p99 falls about as D^-0.6).
+QUALITY_CAPS = {"draft": 16384, "8-bit": 65536, "16-bit": 65536}
 SAMPLES_PER_TEXEL_CHOICES = (
     Choice(1, "Off", "one sample at each texel centre"),
     Choice(4, "4 Samples", "a 2 x 2 grid of points in each texel, averaged"),
@@ -82,8 +86,9 @@ class BakeSettings:
         subtype='PIXEL', description="width and height of the AO map (also limited by the GPU's texture size)")
     directions: int = setting(
         256, label="Directions", minimum=1, maximum=MAX_DIRECTIONS, soft_max=4096,
-        description="light directions (with a Quality or Max Error: at most this many); noise falls about as "
-                    "directions^-0.75, time grows linearly")
+        description="light directions (with Quality 'custom' or a Max Error: at most this many; the Draft, 8-Bit "
+                    "and 16-Bit presets have their own caps); noise falls about as directions^-0.75, time grows "
+                    "linearly")
     quality: str = setting(
         "fixed", label="Quality", choices=QUALITY_CHOICES,
         description="bake a fixed number of directions, or add them in rounds until the bake's own estimate of "
@@ -192,6 +197,12 @@ class BakeSettings:
         """The p99 error this bake adds directions until (0: exactly Directions)."""
         preset = QUALITY_ERRORS[self.quality]
         return self.max_error if preset is None or (preset == 0.0 and self.max_error > 0.0) else preset
+
+    @property
+    def direction_cap(self) -> int:
+        """The most directions a bake to an error may use: a preset's own cap (QUALITY_CAPS),
+        else Directions."""
+        return QUALITY_CAPS.get(self.quality, self.directions)
 
     @property
     def spread_cos(self) -> float:
