@@ -361,7 +361,11 @@ def main() -> int:
     ap.add_argument("--parts", default=",".join(ALL_PARTS),
                     help="what to run; the other parts stay as the previous hao_bench.json has them")
     ap.add_argument("--plot-only", action="store_true", help="redraw hao_bench.png from hao_bench.json")
+    ap.add_argument("--resolution", default=f"{WIDTH}x{HEIGHT}",
+                    help="frame size WxH (tools/gpu_bench.sh: 1920x1080); the AO map is 1/scale of it")
     args = ap.parse_args()
+    global WIDTH, HEIGHT
+    WIDTH, HEIGHT = (int(v) for v in args.resolution.split("x"))
     if args.plot_only:
         plot(json.loads((Path(args.out) / "hao_bench.json").read_text()), Path(args.out) / "hao_bench.png")
         return 0
@@ -477,7 +481,7 @@ def plot(results, path) -> None:
                 bottom += vals
             ax.plot(names, [results["frame"][n]["workbench_ms"] for n in names], "k*", ms=12, label="Workbench")
             ax.plot(names, [3 * results["frame"][n]["workbench_ms"] for n in names], "r_", ms=30, label="3x Workbench")
-            ax.set_ylabel("ms at 800x600 (Table 1 settings)")
+            ax.set_ylabel(f"ms at {results['settings']['width']}x{results['settings']['height']} (Table 1 settings)")
             ax.set_title("HAO frame by pass vs Workbench")
             ax.legend(fontsize=7)
         elif panel == "distances":
