@@ -1,19 +1,22 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Where a bake's error stops falling: the gather's maps against the independent
-truth (bench/truth.py: Embree, at each texel centre), by direction count and light-view
-resolution (view samples), in one run.
+"""Whether a bake's stated error is its whole error: every method's maps against the
+independent truth (bench/truth.py: Embree, converged), by direction count, on Spot, the rocker
+arm, the bunny and fandisk, flat and smooth, in one run.
 
-    .venv/bin/python bench/floor_bench.py [--meshes samples/spot.obj ...] [--size 128] [--rays 8192]
+    .venv/bin/python bench/floor_bench.py [--meshes ...] [--size 128] [--rays 32768]
 
-Meshes: Spot, the rocker arm, the bunny and fandisk, flat (normals 'face'); those without UVs
-are unwrapped as a bake unwraps them.
-
-Per row: the measured RMSE, p99 and bias against the truth, the same without the worst 0.2 %
-of the texels (the tail: texel centres on UV edges between triangles of other normals, where
-the bake and the truth may pick other triangles), the bake's stated RMSE and p99, and how
-the squared error splits between the tail and the rest. The truth's own noise is reported
-(two seeds); it is taken out of the measured RMSE (sqrt(measured^2 - noise^2)).
-Writes floor_bench.json into the output folder.
+Each map is measured against the truth that matches what its texels are:
+- the gather: the AO at each texel's sample point, where its GPU texel list put it
+  (truth.bake_sample_points: the texel centre, on the face its rasterizer picked);
+- the reference: the AO at the texel centre on the face the CPU raster picks (texel_samples);
+- the scatter: the average over each texel's area (truth at a 4 x 4 grid of points per texel,
+  averaged over the covered ones).
+Smooth rows shade with Blender's smooth corner normals and Cycles' terminator offset (the
+truth lifts its rays the same way). Per row: measured RMSE (the truth's own noise taken out)
+and p99 against the truth, the bake's stated RMSE and p99, their ratios (measured / stated),
+and the visibility floor the bake measured in it (hao_addon/floor_check.py). The reference
+runs up to 1024 directions (its rays are a Python call each). Writes floor_bench.json into the
+output folder.
 """
 from __future__ import annotations
 
@@ -22,6 +25,7 @@ import json
 import platform
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -30,69 +34,92 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import numpy as np  # noqa: E402
 
-from truth import texel_truth  # noqa: E402
+from truth import Truth, bake_sample_points, reference_sample_points, texel_samples, truth_at  # noqa: E402
 
-TAIL = 0.002  # the worst share of texels reported apart
 MESHES = (ROOT / "samples" / "spot.obj", ROOT / "tests" / "data" / "rocker-arm.obj",
           ROOT / "bench" / "data" / "stanford-bunny.obj", ROOT / "tests" / "data" / "fandisk.obj")
+DIRECTIONS = {"gather": (64, 256, 1024, 4096, 16384), "scatter": (64, 256, 1024, 4096),
+              "reference": (64, 256, 1024)}
+AREA_GRID = 4  # the scatter's truth: points per texel side
 
 
-def row(ao: np.ndarray, covered: np.ndarray, truth, stated) -> dict:
-    error = ao[covered] - truth.values[covered]
-    magnitude = np.abs(error)
-    keep = magnitude < np.quantile(magnitude, 1.0 - TAIL)
-    squared = error ** 2
+def area_truth(soup, size: int, rays: int, shading: bool) -> Truth:
+    """The truth of texel-area averages: AREA_GRID^2 points per texel, rays / AREA_GRID^2 each."""
+    fine = texel_samples(soup, size * AREA_GRID, shading)
+    t = truth_at(soup, [], (*fine, None, 0.0), rays=max(2, rays // AREA_GRID ** 2))
+    k = AREA_GRID
+    cover = t.covered.reshape(size, k, size, k).sum(axis=(1, 3))
+    total = (t.values * t.covered).reshape(size, k, size, k).sum(axis=(1, 3))
+    values = np.divide(total, cover, out=np.zeros(total.shape), where=cover > 0)
+    return Truth(values, cover == k * k, t.noise / k)  # interior texels: every point covered
 
-    def rmse(e):
-        return float(np.sqrt(max(np.mean(e ** 2) - truth.noise ** 2, 0.0)))
-    return {"rmse": rmse(error), "p99": float(np.quantile(magnitude, 0.99)), "bias": float(error.mean()),
-            "rmse_without_tail": rmse(error[keep]), "p99_without_tail": float(np.quantile(magnitude[keep], 0.99)),
-            "tail_share_of_squared_error": float(squared[~keep].sum() / squared.sum()),
-            "stated_rmse": stated.rmse, "stated_p99": stated.p99}
+
+def truths(soup, settings, rays: int) -> dict:
+    """The matching truth of each method (see the module docstring)."""
+    smooth = soup.normals is not None
+    out = {"gather": truth_at(soup, [], bake_sample_points(soup, settings), rays=rays),
+           "reference": truth_at(soup, [], reference_sample_points(soup, settings), rays=rays)}
+    out["scatter"] = area_truth(soup, settings.size, rays, smooth)
+    return out
+
+
+def row(result, truth: Truth) -> dict:
+    both = result.covered & truth.covered
+    error = result.ao[both] - truth.values[both]
+    rmse = float(np.sqrt(max(np.mean(error ** 2) - truth.noise ** 2, 0.0)))
+    p99 = float(np.quantile(np.abs(error), 0.99))
+    stated = result.error
+    return {"measured_rmse": rmse, "measured_p99": p99, "bias": float(error.mean()),
+            "stated_rmse": stated.rmse, "stated_p99": stated.p99,
+            "rmse_ratio": rmse / stated.rmse, "p99_ratio": p99 / stated.p99,
+            "floor_rmse": stated.floor_rmse, "floor_p99": stated.floor_p99, "floor_texels": stated.floor_texels,
+            "texels": int(both.sum())}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--meshes", nargs="+", default=[str(p) for p in MESHES])
     ap.add_argument("--size", type=int, default=128)
-    ap.add_argument("--rays", type=int, default=8192)
-    ap.add_argument("--directions", type=int, nargs="+", default=[1024, 4096, 16384])
-    ap.add_argument("--view-samples", type=float, nargs="+", default=[2.0, 8.0])
+    ap.add_argument("--rays", type=int, default=32768)
+    ap.add_argument("--methods", default="gather,reference,scatter")
+    ap.add_argument("--view-samples", type=float, default=2.0)
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
     args = ap.parse_args()
-    from hao_addon.bake import bake
     from hao_addon.blender.gpu_context import ensure_gpu_context
-    from hao_addon.core.bake.settings import BakeSettings
-    from hao_addon.core.objfile import obj_soup
     ensure_gpu_context()
-    rows, truths = [], {}
+    from hao_addon.bake import bake
+    from hao_addon.core.bake.settings import BakeSettings
+    from hao_addon.core.geometry import smooth_vertex_normals
+    from hao_addon.core.objfile import obj_soup
+    rows, truth_info = [], {}
     for mesh in args.meshes:
         try:
-            soup = obj_soup(mesh)
+            flat = obj_soup(mesh)
         except ValueError:  # no UVs: unwrapped as a bake unwraps them
-            soup = obj_soup(mesh, uvs="auto", size=args.size)
-        name = Path(mesh).stem
-        start = time.perf_counter()
-        truth = texel_truth(soup, [], args.size, rays=args.rays)
-        truths[name] = {"texels": int(truth.covered.sum()), "noise_rmse": truth.noise,
-                        "seconds": time.perf_counter() - start}
-        print(f"truth of {name}: {truths[name]}", flush=True)
-        for view_samples in args.view_samples:
-            for directions in args.directions:
-                settings = BakeSettings(size=args.size, directions=directions, margin=0, normals="face",
-                                        method="gather", view_samples=view_samples)
-                start = time.perf_counter()
-                result = bake(soup, [], settings, use_cache=False)
-                rows.append({"mesh": name, "view_samples": view_samples, "directions": directions,
-                             "seconds": time.perf_counter() - start,
-                             **row(result.ao, result.covered & truth.covered, truth, result.error)})
-                print(json.dumps(rows[-1]), flush=True)
+            flat = obj_soup(mesh, uvs="auto", size=args.size)
+        for shading, soup in (("flat", flat), ("smooth", replace(flat, normals=smooth_vertex_normals(flat.positions)))):
+            name = f"{Path(mesh).stem} {shading}"
+            settings = BakeSettings(size=args.size, margin=0, normals="mesh" if shading == "smooth" else "face",
+                                    view_samples=args.view_samples)
+            start = time.perf_counter()
+            matching = truths(soup, settings, args.rays)
+            truth_info[name] = {m: {"texels": int(t.covered.sum()), "noise_rmse": t.noise} for m, t in matching.items()}
+            truth_info[name]["seconds"] = time.perf_counter() - start
+            print(f"truths of {name}: {truth_info[name]}", flush=True)
+            for method in args.methods.split(","):
+                for directions in DIRECTIONS[method]:
+                    start = time.perf_counter()
+                    result = bake(soup, [], replace(settings, method=method, directions=directions), use_cache=False)
+                    rows.append({"mesh": Path(mesh).stem, "shading": shading, "method": method,
+                                 "directions": directions, "seconds": time.perf_counter() - start,
+                                 **row(result, matching[method])})
+                    print(json.dumps(rows[-1]), flush=True)
     import bpy
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "floor_bench.json").write_text(json.dumps({
-        "size": args.size, "normals": "face", "method": "gather",
-        "truth": {"rays": args.rays, "tracer": "Embree (embreex)", "meshes": truths},
+        "size": args.size, "view_samples": args.view_samples,
+        "truth": {"rays": args.rays, "tracer": "Embree (embreex)", "meshes": truth_info},
         "machine": {"platform": platform.platform(), "python": platform.python_version(),
                     "blender": bpy.app.version_string},
         "rows": rows}, indent=1) + "\n")
