@@ -6,6 +6,17 @@
  * Overlapping UV islands give one entry per island, and their sums average later. Entry
  * order within a bin follows the rasterizer's threads; every entry is processed on its own,
  * so the order does not change any result. */
+
+/* The fragment's barycentric coordinates moved SAMPLE_INSET inside its face: the rasterizer
+ * snaps a covered centre up to 1/256 texel past the face's edge, and interpolation can put it
+ * just behind a neighbouring face at a concave crease (core/bake/uv_raster.inset_barycentrics,
+ * the CPU twin). */
+vec3 inset_bary()
+{
+  vec3 b = max(face_bary, vec3(SAMPLE_INSET));
+  return b / (b.x + b.y + b.z);
+}
+
 void main()
 {
   /* llvmpipe skips fragment shaders with side effects when no colour is written. */
@@ -27,7 +38,8 @@ void main()
     return;
   }
   ivec2 slot = ivec2(int(index % uint(LIST_WIDTH)), int(index / uint(LIST_WIDTH)));
-  imageStore(entry_position, slot, vec4(world_pos, face_data.w));
+  vec3 bary = inset_bary();
+  imageStore(entry_position, slot, vec4(face_v0 * bary.x + face_v1 * bary.y + face_v2 * bary.z, face_data.w));
 #  ifdef SHADING_NORMALS
   /* Both normals: the weight is about the shading one, visibility and its bias belong to the
    * true surface. */
@@ -37,8 +49,8 @@ void main()
 #  endif
   imageStore(entry_texel, slot, uvec4((uint(gl_FragCoord.y) << 16) | uint(gl_FragCoord.x)));
 #  ifdef TERMINATOR_OFFSET
-  imageStore(entry_lift, slot, vec4(smooth_surface_lift(lift_v0, lift_v1, lift_v2, lift_n0, lift_n1, lift_n2,
-                                                        lift_bary, geometric_normal), 0.0));
+  imageStore(entry_lift, slot, vec4(smooth_surface_lift(face_v0, face_v1, face_v2, lift_n0, lift_n1, lift_n2,
+                                                        bary, geometric_normal), 0.0));
 #  endif
 #endif
 }

@@ -98,3 +98,38 @@ def test_presets_cap_themselves_and_a_capped_bake_says_what_it_needs(gpu_context
                   use_cache=False)
     assert capped.error.capped and capped.stats["directions_needed"] > 128
     assert any("needs about" in w and "raise Directions" in w for w in capped.stats["warnings"])
+
+
+def crease_soup(size: int) -> "TriangleSoup":
+    """A floor (z = 0, x in [0, 1]) meeting a wall (x = 0, facing +x) at a concave right angle,
+    their UV charts sharing the crease on a column of texel centres (u = 8.5 / 16 at 16^2)."""
+    from hao_addon.core.geometry import TriangleSoup
+    c = (size // 2 + 0.5) / size
+    floor = [[(0, 0, 0), (1, 0, 0), (1, 1, 0)], [(0, 0, 0), (1, 1, 0), (0, 1, 0)]]
+    wall = [[(0, 0, 0), (0, 1, 0), (0, 1, 1)], [(0, 0, 0), (0, 1, 1), (0, 0, 1)]]
+    uv_floor = [[(c + x * (1 - c), y) for x, y, _z in tri] for tri in floor]
+    uv_wall = [[(c - z * c, y) for _x, y, z in tri] for tri in wall]
+    return TriangleSoup(np.array(floor + wall, float), np.array(uv_floor + uv_wall, float), name="crease")
+
+
+@pytest.mark.parametrize("method", ["gather", "reference"])
+def test_sample_points_lie_inside_their_face_at_a_crease(gpu_context, method):
+    """Texel centres on a UV edge that is a concave crease sample a point inside their own face
+    (core/bake/uv_raster.SAMPLE_INSET), not on the crease, where rounding put the GPU's points
+    behind the other face: the exact truth there read 0 (every ray left through that face's back)
+    where the bakes gave 0.4-0.5 (fandisk at 128^2, five texels)."""
+    from truth import bake_sample_points, reference_sample_points, truth_at
+    size = 16
+    soup = crease_soup(size)
+    settings = BakeSettings(size=size, margin=0, directions=4, method=method)
+    samples = (bake_sample_points if method == "gather" else reference_sample_points)(soup, settings)
+    covered, points, _shading, geometric = samples[:4]
+    column = (np.flatnonzero(covered.ravel()) % size) == size // 2
+    assert column.sum() >= size - 2  # the crease's texels are sampled, on one face or the other
+    on_floor = geometric[:, 2] > 0.5
+    inside = np.where(on_floor, points[:, 0], points[:, 2])  # distance from the crease into the face
+    assert inside[column].min() > 1e-4, inside[column].min()
+    truth = truth_at(soup, [], samples, rays=1024)
+    ys, xs = np.nonzero(covered)
+    crease = truth.values[ys[column], xs[column]]
+    assert crease.min() > 0.3, crease  # about half the hemisphere is behind the other face

@@ -36,6 +36,7 @@ from ..core.directions import probe_first, probe_half, replicate_sizes
 from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
+from ..core.bake.uv_raster import SAMPLE_INSET
 from . import util
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .shaders import cached_shader, glsl_source, glsl_struct, shader_variants
@@ -51,9 +52,12 @@ def entry_bytes(plan: BakePlan) -> int:
     return ENTRY_BYTES + 4 * plan.estimator.channel_count + (LIFT_BYTES if plan.lifts_terminator else 0)
 
 
-# The texel-list attributes of the terminator lift (plan_batch's lift_corners): the face's
-# corners and their shading normals at every corner, and the corner's barycentric unit vector.
-LIFT_ATTRIBUTES = ("tri_v0", "tri_v1", "tri_v2", "tri_n0", "tri_n1", "tri_n2", "corner_bary")
+# The texel-list attributes of every corner (plan_batch's face_bins): its face's corners and
+# the corner's barycentric unit vector, so a fragment puts its point inside its face
+# (core/bake/uv_raster.SAMPLE_INSET); with the terminator lift (lift_corners) also the corners'
+# shading normals.
+FACE_ATTRIBUTES = ("tri_v0", "tri_v1", "tri_v2", "corner_bary")
+LIFT_ATTRIBUTES = ("tri_n0", "tri_n1", "tri_n2")
 
 
 def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.GPUShaderCreateInfo":
@@ -68,6 +72,13 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
     info.vertex_in(2, 'VEC4', "face")
     info.vertex_in(3, 'FLOAT', "bin")
     info.vertex_in(4, 'VEC3', "geometric")
+    info.define("SAMPLE_INSET", f"{SAMPLE_INSET:.9g}")
+    for k, name in enumerate(FACE_ATTRIBUTES):
+        info.vertex_in(5 + k, 'VEC3', name)
+        if name == "corner_bary":
+            iface.smooth('VEC3', "face_bary")
+        else:
+            iface.flat('VEC3', "face_" + name[4:])
     if shading:  # entries binned by their own shading normal
         info.define("SHADING_NORMALS", "1")
         info.define("OCT_SIDE", str(OCT_SIDE))
@@ -75,11 +86,8 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
         assert shading
         info.define("TERMINATOR_OFFSET", "1")
         for k, name in enumerate(LIFT_ATTRIBUTES):
-            info.vertex_in(5 + k, 'VEC3', name)
-            if name == "corner_bary":
-                iface.smooth('VEC3', "lift_bary")
-            else:
-                iface.flat('VEC3', "lift_" + name[4:])
+            info.vertex_in(5 + len(FACE_ATTRIBUTES) + k, 'VEC3', name)
+            iface.flat('VEC3', "lift_" + name[4:])
     info.vertex_out(iface)
     info.fragment_out(0, 'VEC4', "list_out")
     info.image(0, 'R32UI', 'UINT_2D', "bin_count", qualifiers={'READ', 'WRITE'})

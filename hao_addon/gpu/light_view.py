@@ -185,9 +185,10 @@ def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = 
     (plan.target_corners) and the above-face fraction (plan.target_above).
     order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
     face normal bins, added as the float attribute "bin" with the face normal as
-    "geometric" (target alone only); lift_corners: with them, each corner also carries its
-    face's corners and shading normals and its barycentric unit vector (the texel list's
-    terminator lift, bake_gather.LIFT_ATTRIBUTES)."""
+    "geometric", each corner's face corners and barycentric unit vector
+    (bake_gather.FACE_ATTRIBUTES; target alone only); lift_corners: with them, each corner also
+    carries its face's shading normals (the texel list's terminator lift,
+    bake_gather.LIFT_ATTRIBUTES)."""
     # Selected to Active: the target is not drawn with the occluders (plan.target_drawn).
     ft = len(plan.target_positions) if plan.target_drawn or not with_occluders else 0
     fo = len(plan.occluder_positions) if with_occluders else 0
@@ -205,12 +206,12 @@ def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = 
         assert fo == 0 and order is None
         attrs["bin"] = ('F32', np.repeat(np.asarray(face_bins, np.float32), 3))
         attrs["geometric"] = ('F32', np.repeat(plan.target_faces[:, :3], 3, axis=0))
+        for k in range(3):
+            attrs[f"tri_v{k}"] = ('F32', np.repeat(plan.target_positions[:, k], 3, axis=0))
+        attrs["corner_bary"] = ('F32', np.tile(np.eye(3, dtype=np.float32), (len(pos), 1)))
         if lift_corners:
-            corners = (plan.target_positions, plan.target_corners[..., :3])
             for k in range(3):
-                attrs[f"tri_v{k}"] = ('F32', np.repeat(corners[0][:, k], 3, axis=0))
-                attrs[f"tri_n{k}"] = ('F32', np.repeat(corners[1][:, k], 3, axis=0))
-            attrs["corner_bary"] = ('F32', np.tile(np.eye(3, dtype=np.float32), (len(pos), 1)))
+                attrs[f"tri_n{k}"] = ('F32', np.repeat(plan.target_corners[:, k, :3], 3, axis=0))
     return util.make_batch('TRIS', attrs)
 
 

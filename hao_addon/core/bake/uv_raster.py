@@ -8,12 +8,27 @@ from __future__ import annotations
 import numpy as np
 
 
+# A texel's sample point lies at least this barycentric share inside its face: a centre on an
+# edge (or, on the GPU, snapped up to 1/256 texel past it) otherwise sits on the crease, where
+# rounding puts it behind a neighbouring face at a concave angle and every ray from it leaves
+# through that face's back (fandisk at 128^2: five texels read 0.000 instead of 0.4-0.5 in the
+# exact truth). 1/1024 of a face's height is far below a texel and above float rounding.
+SAMPLE_INSET = 1.0 / 1024.0
+
+
+def inset_barycentrics(bary: np.ndarray) -> np.ndarray:
+    """(..., 3) barycentric coordinates moved SAMPLE_INSET inside their triangle (the GLSL twin:
+    bake_texel_list.frag's inset_bary)."""
+    b = np.maximum(bary, SAMPLE_INSET)
+    return b / b.sum(axis=-1, keepdims=True)
+
+
 def texel_surface_samples(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For every texel whose centre lies in a UV triangle, that triangle and the barycentric
     coordinates of the centre.
 
     uvs: (F, 3, 2) UV corners in [0, 1]. Returns (face_index (size, size) int64, -1 where
-    uncovered; bary (size, size, 3) float64; hits (size, size) int32: how many triangles
+    uncovered; bary (size, size, 3) float64, inset_barycentrics' where covered; hits (size, size) int32: how many triangles
     contain the centre (> 1 where UV islands overlap)). Row y holds v = (y + 0.5) / size.
     """
     face = np.full((size, size), -1, dtype=np.int64)
@@ -43,6 +58,8 @@ def texel_surface_samples(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.nd
         bary[yy[first], xx[first]] = np.stack([w0[inside], w1[inside], w2[inside]], axis=1)[first]
         strict = (w0 > 1e-7) & (w1 > 1e-7) & (w2 > 1e-7)
         hits[ys[strict], xs[strict]] += 1
+    covered = face >= 0
+    bary[covered] = inset_barycentrics(bary[covered])
     return face, bary, hits
 
 
