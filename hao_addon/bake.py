@@ -336,7 +336,13 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
     """result with its stated error made whole: the visibility floor measured at sampled
     texels (hao_addon/floor_check.py) added to the twins' estimate, and a warning where that
     puts a bake to an error above its target."""
-    if result.error is None or result.twin is None or shared.get("floor_probe") is None:
+    if result.error is None or result.twin is None:
+        return result
+    ran = declaration(result.stats["method"])
+    if ran.gpu and ran.floor_unchecked:  # said, so the twins' part is not read as the whole error
+        error = replace(result.error, floor_unmeasured=ran.floor_unchecked)
+        return replace(result, error=error, stats={**result.stats, "error": error.as_dict()})
+    if shared.get("floor_probe") is None:
         return result
     probe = shared["floor_probe"]
     if shared.get("floor_found", (None,))[0] is not probe:  # a bake to an error measures it once per probe

@@ -181,7 +181,8 @@ def test_cli_reports_the_error_and_writes_the_error_map(tmp_path):
     assert run.returncode == 0, run.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     error = report["objects"][0]["error"]
-    assert set(error) == {"rmse", "p99", "directions", "capped", "floor_rmse", "floor_p99", "floor_texels"}
+    assert set(error) == {"rmse", "p99", "directions", "capped", "floor_rmse", "floor_p99", "floor_texels",
+                          "floor_unmeasured"}
     assert error["directions"] == 64 and error["floor_texels"] > 0
     assert 0.0 < error["rmse"] < error["p99"] < 0.2 and error["capped"] is False
     assert (f"error ~{error['rmse']:.2g} RMSE, {error['p99']:.2g} p99 (64 directions; visibility floor "

@@ -77,11 +77,15 @@ def test_the_stated_error_is_the_whole_error_against_the_truth(spot_truth, monke
 
 def test_the_reference_and_the_scatter_state_no_floor(gpu_context):
     """Their floors are not measured: the reference's visibility is exact, the scatter's texels
-    are area averages (core/bake/abilities.py, floor_unchecked)."""
+    are area averages (core/bake/abilities.py, floor_unchecked), which its report says."""
     floor, ball = scenes.grid_plane(4.0, 4, name="floor"), scenes.uv_sphere(0.6, (0, 0, 0.6), 12, 6, name="ball")
     for method in ("reference", "scatter"):
         result = bake(floor, [ball], BakeSettings(size=16, directions=64, method=method, margin=0), use_cache=False)
         assert result.error.floor_texels == 0 and result.error.floor_rmse == 0.0
+        # The scatter's floor exists but is not measured, and its report says so; the
+        # reference's visibility is exact: it has none to state.
+        unmeasured = "visibility floor not measured" in result.error.text()
+        assert unmeasured == (method == "scatter") == bool(result.error.floor_unmeasured)
 
 
 def test_presets_cap_themselves_and_a_capped_bake_says_what_it_needs(gpu_context):

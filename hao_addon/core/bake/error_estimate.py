@@ -68,13 +68,17 @@ class ErrorEstimate:
     floor_rmse: float = 0.0
     floor_p99: float = 0.0
     floor_texels: int = 0
+    # Why a GPU method's floor is not measured (abilities.floor_unchecked: the scatter's area
+    # averages, up to 7x its twins' estimate at 128^2 in bench/floor_bench.py), '' otherwise.
+    floor_unmeasured: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)
 
     def text(self) -> str:
         """'error ~0.0042 RMSE, 0.011 p99 (256 directions)' for summary lines and reports."""
-        floor = f"; visibility floor {self.floor_rmse:.2g} RMSE" if self.floor_texels else ""
+        floor = (f"; visibility floor {self.floor_rmse:.2g} RMSE" if self.floor_texels else
+                 "; visibility floor not measured" if self.floor_unmeasured else "")
         return (f"error ~{self.rmse:.2g} RMSE, {self.p99:.2g} p99 ({self.directions} directions"
                 f"{', capped' if self.capped else ''}{floor})")
 
