@@ -346,7 +346,8 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
         return result
     probe = shared["floor_probe"]
     if shared.get("floor_found", (None,))[0] is not probe:  # a bake to an error measures it once per probe
-        shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"])))
+        shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"],
+                                                                 result.error.directions)))
     found = shared["floor_found"][1]
     if found is None:
         return result

@@ -3,11 +3,14 @@
 their resolution and bias, the texel list's choice of face on an edge) gets wrong, which more
 directions never remove. No Blender data: numpy in and out, as hao_addon.bake.
 
-How: at up to FLOOR_TEXELS sampled texels, the map's partial sums after the first
+How: at floor_texel_count() sampled texels, the map's partial sums after the first
 probe_half() directions of each replicate (a random subset of it: core/directions.probe_first,
-which the gather bakes first) are read back (a probe), and the CPU reference traces exactly
-those directions from the bake's own sample points. The difference holds no direction noise,
-only the visibility test's error, and it estimates the floor proper for any direction count:
+which the GPU bakers bake first) are read back (a probe), and the CPU reference traces exactly
+those directions from the bake's own sample points (the gather's texel list; for the
+scatter, whose texels are area averages, a random point of each texel's area per replicate).
+The difference holds no direction noise, only the visibility test's error (and for the
+scatter the point's own offset from the area average, which the replicates do not share),
+and it estimates the floor proper for any direction count:
 under the random rotation every direction of any subset is uniform on the sphere, so the
 difference's expectation is the same for a few directions as for all of them
 (core/bake/error_estimate.with_floor takes the part the two replicates share). A probe of a
@@ -31,13 +34,16 @@ from .core.bake.receivers import Receivers
 from .core.bake.verify import pick_cells
 from .core.directions import probe_half, replicate_sizes
 
-# Texels checked: about 2 per direction of the bake, between MIN_FLOOR_TEXELS and FLOOR_TEXELS
-# (all covered texels of a smaller map). With probe_half() directions per replicate that is
-# 131k rays at 256 directions, 524k at 1024, 2.1M from 4096 on (about half of them traced,
-# above the surface; 0.4, 1.5 and 6 s here: about an eighth of a 1024^2 gather bake's time).
-FLOOR_TEXELS = 1024
+# Texels checked: as many as FLOOR_RAYS_PER_DIRECTION rays per direction of the bake buy
+# (at most FLOOR_RAYS_MAX) with probe_half() directions per replicate, at least
+# MIN_FLOOR_TEXELS, and every covered texel of a smaller map. That is 1024 texels at 256
+# directions, 2048 at 1024, 4096 at 4096 and 16384 from 16384 on: 131k, 524k, 2.1M and 8.4M
+# rays, about half of them traced (above the surface); 0.3, 1.1, 4 and 16 s here, about a
+# fifth of the bake's own time. The floor is heavy-tailed, so the texels count, not the rays
+# per texel (core/directions.py, PROBE_MIN).
+FLOOR_RAYS_PER_DIRECTION = 512
+FLOOR_RAYS_MAX = 1 << 23
 MIN_FLOOR_TEXELS = 256
-TEXELS_PER_DIRECTION = 2
 FLOOR_SEED = 7907  # the sample's seed, apart from the verification's
 # Rays from the GPU's sample points start this many light-view pixels off the surface. A
 # texel-list point lies on its face's plane, but the rasterizer's snapping (1/256 of a texel
@@ -63,8 +69,9 @@ class FloorProbe:
 
 
 def floor_texel_count(directions: int) -> int:
-    """How many texels a bake of `directions` checks."""
-    return int(np.clip(TEXELS_PER_DIRECTION * directions, MIN_FLOOR_TEXELS, FLOOR_TEXELS))
+    """How many texels a bake of `directions` checks (fewer where the map covers fewer)."""
+    rays = min(FLOOR_RAYS_PER_DIRECTION * directions, FLOOR_RAYS_MAX)
+    return max(MIN_FLOOR_TEXELS, rays // (2 * probe_half(max(directions, 2))))
 
 
 def probe_steps(method: str, count: int, best: int) -> dict | None:
@@ -81,14 +88,24 @@ def probe_steps(method: str, count: int, best: int) -> dict | None:
 
 
 def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed: int
-                 ) -> tuple[np.ndarray, Receivers] | None:
-    """(cells (n,) sorted, the baker's own receivers there) of floor_texel_count(directions)
-    random covered cells, taken from a live baker of `method` (its sample_receivers); None where
-    the method's floor is not measured (abilities.floor_unchecked)."""
+                 ) -> tuple[np.ndarray, tuple[Receivers, Receivers]] | None:
+    """(cells (n,) sorted, the baker's own receivers there for each replicate) of
+    floor_texel_count(directions) random covered cells, taken from a live baker of `method`
+    (its sample_receivers: the gather's sample points, the same for both; a random point of
+    each texel's area for the scatter, one per replicate, so that what the point misses of the
+    area average is noise the replicates do not share); None where the method's floor is not
+    measured (abilities.floor_unchecked)."""
     if declaration(method).floor_unchecked or not hasattr(baker, "sample_receivers"):
         return None
-    cells = pick_cells(covered, floor_texel_count(directions), (seed + FLOOR_SEED) % 2**31)
-    return cells, baker.sample_receivers(cells)
+    # Twice the texels are drawn, the first that have points in both draws kept: the
+    # scatter's footprint splats reach texels outside every UV triangle, which have none.
+    wanted = floor_texel_count(directions)
+    cells = pick_cells(covered, 2 * wanted, (seed + FLOOR_SEED) % 2**31)
+    draws = baker.sample_receivers(cells, 0), baker.sample_receivers(cells, 1)
+    held = np.intersect1d(draws[0].texel, draws[1].texel)
+    if len(held) > wanted:
+        held = np.sort(np.random.default_rng([seed, FLOOR_SEED, 1]).choice(held, size=wanted, replace=False))
+    return held, tuple(r.subset(np.isin(r.texel, held)) for r in draws)
 
 
 def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.ndarray) -> FloorProbe:
@@ -105,17 +122,24 @@ def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.nda
     return FloorProbe(plan, half, np.stack([order[:half], order[split:split + half]]), values)
 
 
-def floor_steps(probe: FloorProbe, sample: tuple[np.ndarray, Receivers]
+def floor_steps(probe: FloorProbe, sample: tuple[np.ndarray, tuple[Receivers, Receivers]], directions: int
                 ) -> Generator[float, None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
     """(cells (n,), floor_a (n,), floor_b (n,)): each replicate's partial value minus the
-    reference's along the same directions from the same points; None where no cell is lit in
-    both. Yields progress in [0, 1]."""
+    reference's along the same directions from the same points, at floor_texel_count(directions)
+    of the sample's cells (a bake to an error draws its sample for its cap, and checks it for
+    the directions it has baked); None where no cell is lit in both. Yields progress in [0, 1]."""
     from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
     cells, receivers = sample
+    values = probe.values
+    wanted = floor_texel_count(directions)
+    if len(cells) > wanted:  # the sample is random, so a random part of it is a sample too
+        keep = np.sort(np.random.default_rng([directions, FLOOR_SEED]).choice(len(cells), size=wanted, replace=False))
+        cells, values = cells[keep], values[:, keep]
+        receivers = tuple(r.subset(np.isin(r.texel, cells)) for r in receivers)
     plan = replace(probe.plan, cells=cells)
     exact = np.full((2, len(cells)), np.nan)
     for k in range(2):
-        baker = ReferenceBaker(plan, receivers, START_OFFSET_PIXELS * plan.pixel_size)
+        baker = ReferenceBaker(plan, receivers[k], START_OFFSET_PIXELS * plan.pixel_size)
         try:
             for i, index in enumerate(probe.steps[k]):
                 baker.run_direction(int(index))
@@ -125,8 +149,8 @@ def floor_steps(probe: FloorProbe, sample: tuple[np.ndarray, Receivers]
             baker.free()
         lit = w > 0.0
         exact[k, lit] = numerator[lit] / w[lit]
-    seen = np.isfinite(exact).all(axis=0) & np.isfinite(probe.values).all(axis=0)
+    seen = np.isfinite(exact).all(axis=0) & np.isfinite(values).all(axis=0)
     if not seen.any():
         return None
-    floor = np.clip(probe.values[:, seen], 0.0, 1.0) - np.clip(exact[:, seen], 0.0, 1.0)
+    floor = np.clip(values[:, seen], 0.0, 1.0) - np.clip(exact[:, seen], 0.0, 1.0)
     return cells[seen], floor[0], floor[1]

@@ -154,3 +154,29 @@ def test_the_uploaded_texel_list_equals_the_gpu_raster(gpu_context, monkeypatch)
     assert uploaded.stats["cpu_receivers"] is True and gpu_list.stats["cpu_receivers"] is False
     assert (uploaded.covered == gpu_list.covered).all()
     np.testing.assert_allclose(uploaded.ao, gpu_list.ao, atol=1e-6)
+
+
+def test_area_points_are_uniform_over_the_covered_part_of_their_texel():
+    """The scatter's floor check draws points of a texel's area (uv_raster.texel_area_points):
+    each lies in its own texel, inside a triangle, and over many draws they spread uniformly
+    over the part the triangles cover (a texel cut by a diagonal: only its lower half)."""
+    from hao_addon.core.bake.uv_raster import texel_area_points
+    half = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]])  # below the diagonal v = u
+    size, cells = 4, np.array([1, 5, 10, 15])  # (1, 0) wholly covered; the others cut in two
+    points, missed = [], 0
+    for seed in range(400):
+        face, bary = texel_area_points(half, size, cells, seed, points=2)
+        assert (face[0] == 0).all() and set(face.ravel().tolist()) <= {0, -1}
+        if (face < 0).any():  # all 8 tries of a cut texel missed: 1 in 256 per texel
+            missed += int((face < 0).sum())
+            continue
+        points.extend(np.einsum("nk,nkd->nd", bary[:, j], half[face[:, j]]) * size for j in range(2))
+    assert missed <= 3 * 400 * 2 * 3 / 256
+    points = np.stack(points)  # (draws, cells, 2) in texel units
+    assert (np.floor(points[..., 0]) == cells % size).all() and (np.floor(points[..., 1]) == cells // size).all()
+    local = points - np.floor(points)
+    assert (local[:, 1:, 1] <= local[:, 1:, 0] + 1e-9).all()  # the cut texels: below their diagonal
+    n = len(points)
+    np.testing.assert_allclose(local[:, 0].mean(axis=0), [0.5, 0.5], atol=4 * np.sqrt(1 / 12 / n))
+    # Uniform over the lower triangle of the unit square: mean (2/3, 1/3).
+    np.testing.assert_allclose(local[:, 1:].mean(axis=0), [[2 / 3, 1 / 3]] * 3, atol=4 * np.sqrt(1 / 18 / n))

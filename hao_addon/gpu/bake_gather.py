@@ -32,7 +32,7 @@ from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, OCT_SIDE, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
                                      normal_bins, octahedral_coords, octahedral_decode, proximity_order)
 from ..core.errors import BakeInputError
-from ..core.directions import probe_first, probe_half, replicate_sizes
+from ..core.directions import probe_order
 from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator, texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
@@ -313,12 +313,8 @@ class GatherBaker(LightViewBaker):
         # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py),
         # each replicate in its own order, one after the other (they are accumulated apart), its
         # floor probe's directions first (core/directions.probe_first).
-        starts = np.cumsum([0, *replicate_sizes(len(plan.directions))])
-        half, order = probe_half(len(plan.directions)), []
-        for a, b in zip(starts[:-1], starts[1:]):
-            for part in probe_first(b - a, half):
-                order.append(a + part[proximity_order(plan.directions[a + part])])
-        self.direction_order = np.concatenate(order)
+        self.direction_order = np.concatenate([part[proximity_order(plan.directions[part])]
+                                               for part in probe_order(len(plan.directions))])
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
@@ -477,10 +473,11 @@ class GatherBaker(LightViewBaker):
             needed = np.ones(BIN_COUNT, bool)
         return bin_runs(needed, self.bin_first)
 
-    def sample_receivers(self, cells: np.ndarray) -> Receivers:
+    def sample_receivers(self, cells: np.ndarray, draw: int = 0) -> Receivers:
         """The list's receivers at `cells` (flat texel indices): this bake's own sample points,
         where its rasterizer put them (on a UV edge shared by two faces it may pick the other
-        face than the CPU's raster, core/bake/uv_raster.py; both are points of the surface)."""
+        face than the CPU's raster, core/bake/uv_raster.py; both are points of the surface).
+        The same for every draw: its texels are these points."""
         if self.receivers is not None:
             receivers = self.receivers.subset(self.receivers.inv_s > 0.0)
             return receivers.subset(np.isin(receivers.texel, cells))

@@ -27,6 +27,9 @@ import numpy as np
 from ..core.errors import BakeInputError
 from ..core.bake.estimators import AMBIENT_OCCLUSION
 from ..core.bake.plan import BakePlan
+from ..core.bake.receivers import Receivers, receivers_at
+from ..core.bake.uv_raster import texel_area_points
+from ..core.directions import probe_order
 from . import util
 from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
                          soup_shader_info)
@@ -83,6 +86,12 @@ def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
     return cached_shader(key, lambda: _splat_info(uniform, layered, wendland, footprint, shading, spread_cos))
 
 
+# Points per texel of the scatter's floor check (sample_receivers). One point alone varies with
+# the AO across its texel, and the floor's estimate swung by 0.86-1.23x between seeds (Spot at
+# 48^2, 4096 directions); a stratified grid would weigh a texel's partly covered cells as whole.
+AREA_POINTS = 4
+
+
 class ScatterBaker(LightViewBaker):
     """Owns the accumulator and the light-view targets of one bake."""
 
@@ -97,6 +106,25 @@ class ScatterBaker(LightViewBaker):
         if plan.estimator is not AMBIENT_OCCLUSION:
             raise BakeInputError(f"the histogram scatter bakes ambient occlusion only, not {plan.estimator.name}; "
                                  f"use the gather (Shadow-Map Gather) or the reference")
+
+    def __init__(self, plan: BakePlan) -> None:
+        super().__init__(plan)
+        # Each replicate's floor probe first (hao_addon/floor_check.py).
+        self.direction_order = np.concatenate(probe_order(len(plan.directions)))
+
+    def sample_receivers(self, cells: np.ndarray, draw: int = 0) -> Receivers:
+        """Receivers at `cells` (flat texel indices) whose exact AO has this bake's texel
+        values as its mean: its texels are averages over their covered area, so AREA_POINTS
+        points a texel, each uniform over that area (core/bake/uv_raster.texel_area_points),
+        new ones for each draw. Texels where no point landed on a triangle are left out."""
+        plan = self.plan
+        cells = np.asarray(cells, np.int64)
+        face, bary = texel_area_points(plan.target_uvs, plan.settings.size, cells,
+                                       seed=(2 * plan.settings.seed + draw) % 2**31, points=AREA_POINTS)
+        found = face >= 0
+        return receivers_at(plan.target_positions, plan.target_faces, plan.target_corners,
+                            np.repeat(cells, AREA_POINTS)[found.ravel()], face[found], bary[found],
+                            plan.lifts_terminator)
 
     @staticmethod
     def bytes_needed(plan: BakePlan) -> int:

@@ -77,8 +77,7 @@ BAKERS = (
                 "bent-normals": "its accumulator packs ambient occlusion's two sums in one word",
                 "udim": "it rasterizes one 0..1 UV tile",
                 "color-attribute": "it rasterizes the UV layout"},
-        bakes_all_cells="it splats every texel its target's triangles cover in each light view",
-        floor_unchecked="its texels are averages over their area, which the reference's point samples do not match"),
+        bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
     BakerDeclaration(
         "gather", "shadow-map gather", gpu=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "

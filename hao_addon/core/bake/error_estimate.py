@@ -68,8 +68,8 @@ class ErrorEstimate:
     floor_rmse: float = 0.0
     floor_p99: float = 0.0
     floor_texels: int = 0
-    # Why a GPU method's floor is not measured (abilities.floor_unchecked: the scatter's area
-    # averages, up to 7x its twins' estimate at 128^2 in bench/floor_bench.py), '' otherwise.
+    # Why a GPU method's floor is not measured (abilities.floor_unchecked; every GPU baker's is
+    # measured today), '' otherwise: a report never passes off the twins' part as the whole.
     floor_unmeasured: str = ""
 
     def as_dict(self) -> dict:

@@ -101,6 +101,13 @@ def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corn
     like the GPU passes interpolate it. lift: with Cycles' terminator lift of each point.
     tiles: the UDIM tiles of a tiled layout (texel tile * size^2 + y * size + x)."""
     texel, face, bary = tiled_sample_points(uvs, size, samples_per_texel, tiles)
+    return receivers_at(positions, faces, corners, texel, face, bary, lift)
+
+
+def receivers_at(positions: np.ndarray, faces: np.ndarray, corners: np.ndarray, texel: np.ndarray,
+                 face: np.ndarray, bary: np.ndarray, lift: bool = False) -> Receivers:
+    """Receivers at surface points (face (m,), bary (m, 3)) adding to `texel` (m,) (BakePlan
+    fields as uv_receivers); points on faces never lit are left out."""
     lit = faces[face, 3] > 0.0
     texel, face, bary = texel[lit], face[lit], bary[lit]
     points = np.einsum("mk,mkd->md", bary, positions[face].astype(np.float64))

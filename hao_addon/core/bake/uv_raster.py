@@ -79,3 +79,69 @@ def interior_mask(face: np.ndarray, hits: np.ndarray, rings: int = 2) -> np.ndar
             shifted[yd, xd] = ok[ys, xs]
             out &= shifted
     return out
+
+
+# Faces tested against the sampled texels at once (texel_area_points): bounds the (face, texel)
+# pairs held in memory, whatever the map's size.
+AREA_FACE_BLOCK = 4096
+
+
+def texel_area_points(uvs: np.ndarray, size: int, cells: np.ndarray, seed: int, points: int = 1, tries: int = 8
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """`points` points per texel of `cells`, each uniform over the part of the texel that UV
+    triangles cover (a texel-area average's random sample: the scatter's floor check,
+    hao_addon/floor_check.py): `tries` uniform points for each, the first one inside a
+    triangle kept (the first triangle in order, as texel_surface_samples picks).
+
+    uvs: (F, 3, 2) UV corners in [0, 1]; cells: (n,) distinct flat texel indices y * size + x.
+    Returns (face (n, points) int64, -1 where no try landed on a triangle; bary (n, points, 3)
+    float64, inset as inset_barycentrics)."""
+    cells = np.asarray(cells, np.int64)
+    n, m = len(cells), points * tries
+    rng = np.random.default_rng([seed, size, n, points])
+    tries_uv = (np.stack([cells % size, cells // size], axis=1)[:, None, :] + rng.random((n, m, 2))) / size
+    best = np.full((n, m), np.iinfo(np.int64).max)  # the first triangle containing each try
+    bary = np.zeros((n, m, 3))
+    slot = np.full(size * size, -1, np.int64)
+    slot[cells] = np.arange(n)
+    p = np.asarray(uvs, np.float64) * size
+    lo = np.clip(np.floor(p.min(axis=1)), 0, size - 1).astype(np.int64)
+    hi = np.clip(np.floor(p.max(axis=1)), 0, size - 1).astype(np.int64)
+    for start in range(0, len(uvs), AREA_FACE_BLOCK):
+        faces = np.arange(start, min(start + AREA_FACE_BLOCK, len(uvs)))
+        area = (hi[faces, 0] - lo[faces, 0] + 1) * (hi[faces, 1] - lo[faces, 1] + 1)
+        face = np.repeat(faces, area)  # every (face, texel of its bounding box) pair
+        k = np.arange(len(face)) - np.repeat(np.cumsum(area) - area, area)
+        width = hi[face, 0] - lo[face, 0] + 1
+        cell = (lo[face, 1] + k // width) * size + lo[face, 0] + k % width
+        sampled = slot[cell] >= 0
+        face, row = face[sampled], slot[cell[sampled]]
+        _pair_barycentrics(np.asarray(uvs, np.float64), face, row, tries_uv, best, bary)
+    landed = (best < np.iinfo(np.int64).max).reshape(n, points, tries)
+    first = landed.argmax(axis=2)[..., None]  # each point's first try that landed
+    found = np.take_along_axis(landed, first, axis=2)[..., 0]
+    face = np.where(found, np.take_along_axis(best.reshape(n, points, tries), first, axis=2)[..., 0], -1)
+    out = np.take_along_axis(bary.reshape(n, points, tries, 3), first[..., None], axis=2)[:, :, 0]
+    out[found] = inset_barycentrics(out[found])
+    return face, out
+
+
+def _pair_barycentrics(uvs: np.ndarray, face: np.ndarray, row: np.ndarray, tries_uv: np.ndarray,
+                       best: np.ndarray, bary: np.ndarray) -> None:
+    """For (face, row) pairs, test row's tries (tries_uv[row]: (pairs, m, 2)) against the
+    face's UV triangle; where a try lies inside a face lower than best's, record the face and
+    the barycentrics (best (n, m), bary (n, m, 3), updated in place)."""
+    a, b, c = (uvs[face, i][:, None, :] for i in range(3))
+    q = tries_uv[row]
+    det = (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (c[..., 0] - a[..., 0]) * (b[..., 1] - a[..., 1])
+    det = np.where(np.abs(det) < 1e-18, np.nan, det)  # a zero-area UV triangle holds no point
+    w1 = ((q[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (c[..., 0] - a[..., 0]) * (q[..., 1] - a[..., 1])) / det
+    w2 = ((b[..., 0] - a[..., 0]) * (q[..., 1] - a[..., 1]) - (q[..., 0] - a[..., 0]) * (b[..., 1] - a[..., 1])) / det
+    w0 = 1.0 - w1 - w2
+    pair, t = np.nonzero((w0 >= 0.0) & (w1 >= 0.0) & (w2 >= 0.0))
+    key = row[pair] * best.shape[1] + t
+    lowest = best.reshape(-1).copy()
+    np.minimum.at(lowest, key, face[pair])  # each try's first triangle so far
+    won = face[pair] == lowest[key]
+    best.reshape(-1)[:] = lowest
+    bary.reshape(-1, 3)[key[won]] = np.stack([w0[pair, t], w1[pair, t], w2[pair, t]], axis=1)[won]
