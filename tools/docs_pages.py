@@ -241,8 +241,9 @@ def readme_numbers() -> str:
                  f"exact rays at sampled texels; against an exact ray-traced truth (128², 64 to 16384 directions) "
                  f"the stated RMSE is {span('reference', ('spot', 'rocker-arm', 'stanford-bunny', 'fandisk'))} of "
                  f"the measured one for the reference and {span('gather', ('spot', 'rocker-arm'))} for the gather "
-                 f"on Spot and the rocker arm, flat and smooth (not yet on fandisk's sharp edges or for the "
-                 f"scatter) ([report](docs/accuracy.md#a-bake-states-its-whole-error)).")
+                 f"on Spot and the rocker arm, flat and smooth (not yet on fandisk's sharp edges; the scatter's "
+                 f"floor is measured since that run) "
+                 f"([report](docs/accuracy.md#a-bake-states-its-whole-error)).")
     hao = _load("hao_bench")
     ours = [row["hao"]["rmse"] for scene in hao["distances"].values() for row in scene["rows"]]
     eevee = [row["eevee"]["rmse"] for scene in hao["distances"].values() for row in scene["rows"] if "eevee" in row]
