@@ -7,9 +7,9 @@ How: at floor_texel_count() sampled texels, the map's partial sums after the fir
 probe_half() directions of each replicate (a random subset of it: core/directions.probe_first,
 which the GPU bakers bake first) are read back (a probe), and the CPU reference traces exactly
 those directions from the bake's own sample points (the gather's texel list; for the
-scatter, whose texels are area averages, a random point of each texel's area per replicate).
-The difference holds no direction noise, only the visibility test's error (and for the
-scatter the point's own offset from the area average, which the replicates do not share),
+scatter, whose texels are area averages, new random points of each texel's area for each
+replicate). The difference holds no direction noise, only the visibility test's error (and for
+the scatter the points' own offset from the area average, which the replicates do not share),
 and it estimates the floor proper for any direction count:
 under the random rotation every direction of any subset is uniform on the sphere, so the
 difference's expectation is the same for a few directions as for all of them
@@ -38,9 +38,9 @@ from .core.directions import probe_half, replicate_sizes
 # (at most FLOOR_RAYS_MAX) with probe_half() directions per replicate, at least
 # MIN_FLOOR_TEXELS, and every covered texel of a smaller map. That is 1024 texels at 256
 # directions, 2048 at 1024, 4096 at 4096 and 16384 from 16384 on: 131k, 524k, 2.1M and 8.4M
-# rays, about half of them traced (above the surface); 0.3, 1.1, 4 and 16 s here, about a
-# fifth of the bake's own time. The floor is heavy-tailed, so the texels count, not the rays
-# per texel (core/directions.py, PROBE_MIN).
+# rays, about half of them traced (above the surface; BVH casts ran at 834k in 1.7 s here).
+# The floor is heavy-tailed, so the texels count, not the rays per texel (core/directions.py,
+# PROBE_MIN). The scatter traces AREA_POINTS (bake_scatter.py) points a texel.
 FLOOR_RAYS_PER_DIRECTION = 512
 FLOOR_RAYS_MAX = 1 << 23
 MIN_FLOOR_TEXELS = 256
@@ -91,17 +91,18 @@ def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed:
                  ) -> tuple[np.ndarray, tuple[Receivers, Receivers]] | None:
     """(cells (n,) sorted, the baker's own receivers there for each replicate) of
     floor_texel_count(directions) random covered cells, taken from a live baker of `method`
-    (its sample_receivers: the gather's sample points, the same for both; a random point of
-    each texel's area for the scatter, one per replicate, so that what the point misses of the
-    area average is noise the replicates do not share); None where the method's floor is not
-    measured (abilities.floor_unchecked)."""
+    (its sample_receivers: the gather's sample points, the same for both; for the scatter
+    (FRESH_DRAWS) new random points of each texel's area per replicate, so that what they miss
+    of the area average is noise the replicates do not share); None where the method's floor
+    is not measured (abilities.floor_unchecked)."""
     if declaration(method).floor_unchecked or not hasattr(baker, "sample_receivers"):
         return None
     # Twice the texels are drawn, the first that have points in both draws kept: the
     # scatter's footprint splats reach texels outside every UV triangle, which have none.
     wanted = floor_texel_count(directions)
     cells = pick_cells(covered, 2 * wanted, (seed + FLOOR_SEED) % 2**31)
-    draws = baker.sample_receivers(cells, 0), baker.sample_receivers(cells, 1)
+    first = baker.sample_receivers(cells, 0)  # the gather's is a readback of its whole texel list: once
+    draws = (first, baker.sample_receivers(cells, 1) if baker.FRESH_DRAWS else first)
     held = np.intersect1d(draws[0].texel, draws[1].texel)
     if len(held) > wanted:
         held = np.sort(np.random.default_rng([seed, FLOOR_SEED, 1]).choice(held, size=wanted, replace=False))

@@ -312,7 +312,7 @@ class GatherBaker(LightViewBaker):
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
         # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py),
         # each replicate in its own order, one after the other (they are accumulated apart), its
-        # floor probe's directions first (core/directions.probe_first).
+        # floor probe's directions first (core/directions.probe_order).
         self.direction_order = np.concatenate([part[proximity_order(plan.directions[part])]
                                                for part in probe_order(len(plan.directions))])
         # Uploaded entries always hold both normals (_upload_texel_list).

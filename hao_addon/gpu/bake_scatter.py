@@ -88,7 +88,8 @@ def splat_shader(uniform: bool, layered: bool, wendland: bool, footprint: bool,
 
 # Points per texel of the scatter's floor check (sample_receivers). One point alone varies with
 # the AO across its texel, and the floor's estimate swung by 0.86-1.23x between seeds (Spot at
-# 48^2, 4096 directions); a stratified grid would weigh a texel's partly covered cells as whole.
+# 48^2, 4096 directions; with 4, 0.86-0.99); a stratified grid would weigh a texel's partly
+# covered cells as whole.
 AREA_POINTS = 4
 
 
@@ -96,6 +97,7 @@ class ScatterBaker(LightViewBaker):
     """Owns the accumulator and the light-view targets of one bake."""
 
     METHOD = "scatter"
+    FRESH_DRAWS = True  # sample_receivers draws new points each time (hao_addon/floor_check.py)
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:

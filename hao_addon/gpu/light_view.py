@@ -298,6 +298,8 @@ class LightViewBaker(util.GPUPass):
         raise NotImplementedError
 
     METHOD = ""  # the bake method's name (core/bake/abilities.py declares what it can bake)
+    # Whether sample_receivers draws new points each call (the floor check's two replicates).
+    FRESH_DRAWS = False
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:

@@ -104,7 +104,8 @@ def texel_area_points(uvs: np.ndarray, size: int, cells: np.ndarray, seed: int, 
     bary = np.zeros((n, m, 3))
     slot = np.full(size * size, -1, np.int64)
     slot[cells] = np.arange(n)
-    p = np.asarray(uvs, np.float64) * size
+    uvs = np.asarray(uvs, np.float64)
+    p = uvs * size
     lo = np.clip(np.floor(p.min(axis=1)), 0, size - 1).astype(np.int64)
     hi = np.clip(np.floor(p.max(axis=1)), 0, size - 1).astype(np.int64)
     for start in range(0, len(uvs), AREA_FACE_BLOCK):
@@ -116,7 +117,7 @@ def texel_area_points(uvs: np.ndarray, size: int, cells: np.ndarray, seed: int, 
         cell = (lo[face, 1] + k // width) * size + lo[face, 0] + k % width
         sampled = slot[cell] >= 0
         face, row = face[sampled], slot[cell[sampled]]
-        _pair_barycentrics(np.asarray(uvs, np.float64), face, row, tries_uv, best, bary)
+        _pair_barycentrics(uvs, face, row, tries_uv, best, bary)
     landed = (best < np.iinfo(np.int64).max).reshape(n, points, tries)
     first = landed.argmax(axis=2)[..., None]  # each point's first try that landed
     found = np.take_along_axis(landed, first, axis=2)[..., 0]
