@@ -18,6 +18,7 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -25,6 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from hao_addon.core.bake.terminator import MIN_LIFT, smooth_surface_lift  # noqa: E402
 from hao_addon.core.bake.uv_raster import texel_surface_samples  # noqa: E402
 from hao_addon.core.kernels import occlusion_weight  # noqa: E402
 
@@ -45,9 +47,25 @@ class Truth:
     noise: float
 
 
-def texel_samples(soup, size: int, shading: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(covered (S, S), points (N, 3), shading normals (N, 3), face normals (N, 3)) of the
-    texel centres inside the soup's UV triangles."""
+class Samples(NamedTuple):
+    """Where a truth is traced: covered (S, S) texels, their points (N, 3) in world units,
+    shading and face normals (N, 3), and for a smooth bake with Cycles' terminator offset the
+    lift at full amount (N, 3) world units, the offset and the shortest lift that counts
+    (terminator.MIN_LIFT in world units: the bakes' own threshold)."""
+
+    covered: np.ndarray
+    points: np.ndarray
+    normals: np.ndarray
+    geometric: np.ndarray
+    lift: np.ndarray | None = None
+    terminator_offset: float = 0.0
+    min_lift: float = 0.0
+
+
+def texel_samples(soup, size: int, shading: bool, terminator_offset: float = 0.0) -> Samples:
+    """The texel centres inside the soup's UV triangles; with shading and a terminator offset,
+    their lift as the bakes compute it (normalized by the soup's own bounding sphere, which
+    is the bakes' normalization)."""
     face, bary, _hits = texel_surface_samples(soup.uvs, size)
     covered = face >= 0
     faces, weights = face[covered], bary[covered]
@@ -56,10 +74,21 @@ def texel_samples(soup, size: int, shading: bool) -> tuple[np.ndarray, np.ndarra
     geometric = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     geometric /= np.maximum(np.linalg.norm(geometric, axis=1, keepdims=True), 1e-300)
     normals = geometric
-    if shading and soup.normals is not None:
-        normals = np.einsum("nk,nkj->nj", weights, soup.normals[faces])
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-    return covered, points, normals, geometric
+    if not (shading and soup.normals is not None):
+        return Samples(covered, points, normals, geometric)
+    normals = np.einsum("nk,nkj->nj", weights, soup.normals[faces])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    if terminator_offset <= 0.0:
+        return Samples(covered, points, normals, geometric)
+    lift = smooth_surface_lift(corners, soup.normals[faces], weights, geometric)
+    return Samples(covered, points, normals, geometric, lift, terminator_offset, MIN_LIFT * _plan_scale(soup))
+
+
+def _plan_scale(soup) -> float:
+    """World units per normalized unit of a bake of `soup` (core/bake/plan.py: the target's
+    bounding sphere)."""
+    from hao_addon.core.geometry import bounding_sphere
+    return bounding_sphere(soup.positions.reshape(-1, 3))[1]
 
 
 def cosine_directions(normals: np.ndarray, rays: int, rng: np.random.Generator) -> np.ndarray:
@@ -90,13 +119,13 @@ def embree_scene(triangles: np.ndarray):
 
 def accessibility(scene, points: np.ndarray, normals: np.ndarray, geometric: np.ndarray, rays: int, seed: int,
                   radius: float, max_distance: float = 0.0, falloff: str = "none", lift: np.ndarray | None = None,
-                  terminator_offset: float = 0.0) -> np.ndarray:
+                  terminator_offset: float = 0.0, min_lift: float = 0.0) -> np.ndarray:
     """(N,) AO at the points: 1 - the mean occlusion weight of `rays` cosine rays each.
     lift: (N, 3) Cycles' terminator lift of each point at full amount (world units), with
     terminator_offset its cut-off: a ray starts lifted by lift_amount (core/bake/terminator.py,
-    the definition the bakes share), and a ray below the face that is lifted is traced
-    instead of counted occluded."""
-    from hao_addon.core.bake.terminator import lift_amount
+    the definition the bakes share) where that lift is longer than min_lift (world units), and a
+    ray below the face that is lifted is traced instead of counted occluded."""
+    from hao_addon.core.bake.terminator import lift_amount, lifted_starts
     rng = np.random.default_rng(seed)
     out = np.empty(len(points))
     per = max(1, CHUNK_RAYS // rays)
@@ -108,7 +137,7 @@ def accessibility(scene, points: np.ndarray, normals: np.ndarray, geometric: np.
         origins = np.broadcast_to((points[sl] + geometric[sl] * (OFFSET * radius))[:, None], d.shape)
         if lift is not None and terminator_offset > 0.0:
             amount = lift_amount(np.einsum("nrj,nj->nr", d, normals[sl]), cos_true, terminator_offset)
-            lifted = amount * np.linalg.norm(lift[sl], axis=1)[:, None] > OFFSET * radius
+            lifted = lifted_starts(amount, np.linalg.norm(lift[sl], axis=1)[:, None], min_lift)
             origins = np.where(lifted[..., None], points[sl][:, None] + lift[sl][:, None] * amount[..., None], origins)
             below &= ~lifted
         origins = origins.reshape(-1, 3)
@@ -125,13 +154,11 @@ def texel_truth(soup, occluders: list, size: int, rays: int = 32768, shading: bo
                 max_distance: float = 0.0, falloff: str = "none", seed: int = 0) -> Truth:
     """The truth of a bake of `soup` (with UVs) among `occluders` at size x size: `rays` rays
     per texel centre, as two halves of independent seeds whose difference gives its noise."""
-    covered, points, normals, geometric = texel_samples(soup, size, shading)
-    return truth_at(soup, occluders, (covered, points, normals, geometric, None, 0.0), rays, max_distance, falloff,
-                    seed)
+    return truth_at(soup, occluders, texel_samples(soup, size, shading), rays, max_distance, falloff, seed)
 
 
-def reference_sample_points(soup, settings) -> tuple:
-    """bake_sample_points' tuple for the reference bake of `soup` with `settings`: its
+def reference_sample_points(soup, settings) -> Samples:
+    """bake_sample_points' Samples for the reference bake of `soup` with `settings`: its
     receivers are the CPU raster's texel centres (plan.receivers(), as texel_samples)."""
     from dataclasses import replace
     from hao_addon.core.bake.plan import make_plan_steps
@@ -143,21 +170,20 @@ def reference_sample_points(soup, settings) -> tuple:
 
 
 def _samples_of(receivers, plan, settings) -> tuple:
-    """One receiver per texel (overlapping UV islands: one entry's), in texel order, in world units."""
+    """Samples of one receiver per texel (overlapping UV islands: one entry's), in texel order."""
     receivers = receivers.subset(receivers.inv_s > 0.0)
     _unique, first = np.unique(receivers.texel, return_index=True)
     receivers = receivers.subset(first)
     covered = np.zeros(settings.size ** 2, bool)
     covered[receivers.texel] = True
     lift = None if receivers.lift is None else receivers.lift * plan.scale
-    return (covered.reshape(settings.size, settings.size), receivers.points * plan.scale + plan.centre,
-            receivers.shading, receivers.geometric, lift, settings.terminator_offset if lift is not None else 0.0)
+    return Samples(covered.reshape(settings.size, settings.size), receivers.points * plan.scale + plan.centre,
+                   receivers.shading, receivers.geometric, lift, settings.terminator_offset if lift is not None else 0.0,
+                   MIN_LIFT * plan.scale)
 
 
-def bake_sample_points(soup, settings) -> tuple:
-    """(covered (S, S), points (N, 3), shading normals (N, 3), face normals (N, 3), terminator
-    lift (N, 3) or None, terminator offset) of the
-    points where a gather bake of `soup` with `settings` samples each texel: its GPU texel
+def bake_sample_points(soup, settings) -> Samples:
+    """The points where a gather bake of `soup` with `settings` samples each texel: its GPU texel
     list read back (the texel centre on the face its rasterizer picked; on a UV edge shared by
     two faces that may be the other face than texel_samples' CPU raster picks, and with flat
     normals the two give other values: both are the AO at a point of the surface). The matching
@@ -176,16 +202,15 @@ def bake_sample_points(soup, settings) -> tuple:
     return _samples_of(receivers, plan, settings)
 
 
-def truth_at(soup, occluders: list, samples, rays: int = 32768, max_distance: float = 0.0, falloff: str = "none",
-             seed: int = 0) -> Truth:
-    """texel_truth at given samples (covered, points, shading normals, face normals, terminator
-    lift or None, terminator offset), such as bake_sample_points'."""
-    covered, points, normals, geometric, lift, terminator_offset = samples
+def truth_at(soup, occluders: list, samples: Samples, rays: int = 32768, max_distance: float = 0.0,
+             falloff: str = "none", seed: int = 0) -> Truth:
+    """texel_truth at given samples, such as bake_sample_points'."""
+    covered, points, normals, geometric, lift, terminator_offset, min_lift = samples
     scene = embree_scene(np.concatenate([soup.positions] + [o.positions for o in occluders]))
     corners = soup.positions.reshape(-1, 3)
     radius = float(np.linalg.norm(corners - corners.mean(axis=0), axis=1).max())
     halves = [accessibility(scene, points, normals, geometric, rays // 2, seed * 2 + k, radius, max_distance,
-                            falloff, lift, terminator_offset) for k in range(2)]
+                            falloff, lift, terminator_offset, min_lift) for k in range(2)]
     values = np.zeros(covered.shape)
     values[covered] = (halves[0] + halves[1]) / 2.0
     noise = float(np.sqrt(np.mean(((halves[0] - halves[1]) / 2.0) ** 2))) if len(points) else 0.0

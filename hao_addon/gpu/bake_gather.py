@@ -37,6 +37,7 @@ from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator, t
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers
 from ..core.bake.uv_raster import SAMPLE_INSET
+from ..core.bake.terminator import MIN_LIFT
 from . import util
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .shaders import cached_shader, glsl_source, glsl_struct, shader_variants
@@ -151,9 +152,6 @@ GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
 # +0.0039 on Spot.
 DEPTH_BIAS_PIXELS = 0.5
 SLOPE_BIAS_PIXELS = 0.25
-# A terminator lift (normalized units) shorter than this leaves a ray start on its facet (the
-# reference tracer's self-intersection offset is of the same size).
-MIN_LIFT = 1e-6
 # Dispatch only the entries of normal bins that can face a view, and draw into a depth map
 # culling one side of the faces only the bins that side can be in (False: every entry and
 # face; the results are the same, tests/test_bake_analytic.py).

@@ -24,7 +24,7 @@ from ..kernels import occlusion_weight
 from .estimators import texel_sums
 from .normalization import hemisphere_weight
 from .plan import BakePlan
-from .terminator import lift_amount
+from .terminator import lift_amount, lifted_starts
 from ..reference import build_bvh, first_hits, hits_along, ray_offset
 from .alpha import expected_visibility
 from .projection import barycentric
@@ -101,8 +101,7 @@ class ReferenceBaker:
         amount = None
         if self.lift is not None:
             amount = lift_amount(cos_shading, cos_true, settings.terminator_offset)
-            # A start lifted by less than the self-intersection offset stays on the facet.
-            lifted = (weight > 0.0) & (amount * np.linalg.norm(self.lift, axis=1) > self.offsets)
+            lifted = (weight > 0.0) & lifted_starts(amount, np.linalg.norm(self.lift, axis=1))
         else:
             lifted = np.zeros(len(self.points), bool)
         d_max = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 0.0
