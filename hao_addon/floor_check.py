@@ -13,7 +13,9 @@ the scatter the points' own offset from the area average, which the replicates d
 and it estimates the floor proper for any direction count:
 under the random rotation every direction of any subset is uniform on the sphere, so the
 difference's expectation is the same for a few directions as for all of them
-(core/bake/error_estimate.with_floor takes the part the two replicates share). A probe of a
+(core/bake/error_estimate.with_floor takes the part the two replicates share; the texels
+with the largest probe floors are checked again along all their round's directions, where the
+part that changes with the rotation is smaller: REFINED_SHARE). A probe of a
 part of the directions lets many texels be checked for few rays: the floor is
 heavy-tailed (Spot at 48^2: two texels of 1118, on triangles a tenth of a light-view pixel,
 held 60 % of its square), and 256 texels missed such texels, stating half the measured error.
@@ -23,16 +25,19 @@ stop converging at RMSE 0.0015-0.005 (128^2, flat), where the twins alone stated
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from typing import Generator
 
 import numpy as np
 
 from .core.bake.abilities import declaration
+from .core.bake.estimators import Estimator
 from .core.bake.plan import BakePlan
 from .core.bake.receivers import Receivers
 from .core.bake.verify import pick_cells
 from .core.directions import probe_half, replicate_sizes
+from .core.steps import relay
 
 # Texels checked: as many as FLOOR_RAYS_PER_DIRECTION rays per direction of the bake buy
 # (at most FLOOR_RAYS_MAX) with probe_half() directions per replicate, at least
@@ -55,17 +60,30 @@ FLOOR_SEED = 7907  # the sample's seed, apart from the verification's
 START_OFFSET_PIXELS = 1.0 / 128.0
 
 
+# The probe's floors hold, besides the floor proper that both replicates share, a part that
+# changes with the rotation (in the twins already; it falls as 1/sqrt(probe directions)), and
+# in a few texels that part is large: Spot at 48^2, 4096 directions, every texel checked,
+# stated 0.68-1.12x the measured RMSE over seeds 0-7, as a handful of texels whose replicates
+# read -0.07 and +0.06 swung the shared part's mean. The REFINED_SHARE of checked texels with
+# the largest probe floors are checked again along all their round's directions, where that
+# part is sqrt(8) smaller (at most the probe's own rays again).
+REFINED_SHARE = 1.0 / 16.0
+
+
 @dataclass
 class FloorProbe:
     """A round's partial sums at the sample: plan: the round's; half: directions per
     replicate; steps: (2, half) the bake's direction indices of each replicate's first half
     steps; values: (2, n) each replicate's partial map value at the sample's cells (NaN where
-    unlit)."""
+    unlit); full_steps: each replicate's every direction index of the round; full_values:
+    (2, n) each replicate's value at the cells after all of them."""
 
     plan: BakePlan
     half: int
     steps: np.ndarray
     values: np.ndarray
+    full_steps: tuple[np.ndarray, np.ndarray]
+    full_values: np.ndarray
 
 
 def floor_texel_count(directions: int) -> int:
@@ -109,18 +127,35 @@ def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed:
     return held, tuple(r.subset(np.isin(r.texel, held)) for r in draws)
 
 
-def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.ndarray) -> FloorProbe:
-    """The FloorProbe of a round from its snapshots (probe_steps) at `cells`."""
+def probe_map(estimator: Estimator, sums: np.ndarray) -> np.ndarray:
+    """(*output_shape) float32: a snapshot's partial map value, NaN where unlit. One channel
+    whatever the estimator's (eight with bent normals): the probe keeps two whole-map snapshots
+    to the bake's end, 67 MB each at 4096^2 (134 MB as float32 sums, 268 MB as float64)."""
+    numerator, w = estimator.ratio(sums)
+    lit = w > 0.0
+    return np.where(lit, np.divide(numerator, w, out=np.zeros(w.shape), where=lit), np.nan).astype(np.float32)
+
+
+def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.ndarray,
+               sums: tuple[np.ndarray, np.ndarray]) -> FloorProbe:
+    """The FloorProbe of a round from its snapshots (probe_steps, each a probe_map) and its
+    replicates' whole sums (replicate_sums_steps) at `cells`."""
     split = replicate_sizes(count)[0]
     first, second = sorted(snapshots)
     half = first
     order = np.asarray(getattr(baker, "direction_order", np.arange(count)))
-    values = np.full((2, len(cells)), np.nan)
-    for k, step in enumerate((first, second)):
-        numerator, w = (part.reshape(-1)[cells] for part in plan.estimator.ratio(snapshots[step]))
-        lit = w > 0.0
-        values[k, lit] = numerator[lit] / w[lit]
-    return FloorProbe(plan, half, np.stack([order[:half], order[split:split + half]]), values)
+    values = np.stack([snapshots[step].reshape(-1)[cells].astype(np.float64) for step in (first, second)])
+    full_values = np.stack([probe_map(plan.estimator, part).reshape(-1)[cells].astype(np.float64) for part in sums])
+    return FloorProbe(plan, half, np.stack([order[:half], order[split:split + half]]), values,
+                      (order[:split], order[split:count]), full_values)
+
+
+def refined_count(checked: int, probe: FloorProbe, directions: int) -> int:
+    """How many of `checked` texels are checked again along all their round's directions:
+    REFINED_SHARE of them, at most as many as the probe's rays buy again."""
+    rays = min(FLOOR_RAYS_PER_DIRECTION * directions, FLOOR_RAYS_MAX)
+    per_texel = sum(len(steps) for steps in probe.full_steps)
+    return int(min(math.ceil(checked * REFINED_SHARE), rays // max(per_texel, 1)))
 
 
 def floor_steps(probe: FloorProbe, sample: tuple[np.ndarray, tuple[Receivers, Receivers]], directions: int
@@ -128,30 +163,53 @@ def floor_steps(probe: FloorProbe, sample: tuple[np.ndarray, tuple[Receivers, Re
     """(cells (n,), floor_a (n,), floor_b (n,)): each replicate's partial value minus the
     reference's along the same directions from the same points, at floor_texel_count(directions)
     of the sample's cells (a bake to an error draws its sample for its cap, and checks it for
-    the directions it has baked); None where no cell is lit in both. Yields progress in [0, 1]."""
-    from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
+    the directions it has baked), and at the refined_count() of them with the largest floors
+    its whole value minus the reference's along all its directions; None where no cell is lit
+    in both. Yields progress in [0, 1]."""
     cells, receivers = sample
-    values = probe.values
+    values, full_values = probe.values, probe.full_values
     wanted = floor_texel_count(directions)
     if len(cells) > wanted:  # the sample is random, so a random part of it is a sample too
         keep = np.sort(np.random.default_rng([directions, FLOOR_SEED]).choice(len(cells), size=wanted, replace=False))
-        cells, values = cells[keep], values[:, keep]
+        cells, values, full_values = cells[keep], values[:, keep], full_values[:, keep]
         receivers = tuple(r.subset(np.isin(r.texel, cells)) for r in receivers)
-    plan = replace(probe.plan, cells=cells)
+    exact = yield from relay(_exact_steps(probe.plan, cells, receivers, probe.steps), lambda f: 0.5 * f)
+    seen = np.isfinite(exact).all(axis=0) & np.isfinite(values).all(axis=0)
+    if not seen.any():
+        return None
+    floor = np.clip(values, 0.0, 1.0) - np.clip(exact, 0.0, 1.0)
+    floor[:, ~seen] = 0.0
+    refined = np.argsort(-(floor ** 2).sum(axis=0), kind="stable")[:refined_count(int(seen.sum()), probe, directions)]
+    refined = np.sort(refined[seen[refined]])
+    if len(refined):
+        subset = tuple(r.subset(np.isin(r.texel, cells[refined])) for r in receivers)
+        exact_all = yield from relay(_exact_steps(probe.plan, cells[refined], subset, probe.full_steps),
+                                     lambda f: 0.5 + 0.5 * f)
+        again = np.isfinite(exact_all).all(axis=0) & np.isfinite(full_values[:, refined]).all(axis=0)
+        floor[:, refined[again]] = (np.clip(full_values[:, refined[again]], 0.0, 1.0)
+                                    - np.clip(exact_all[:, again], 0.0, 1.0))
+    return cells[seen], floor[0, seen], floor[1, seen]
+
+
+def _exact_steps(plan: BakePlan, cells: np.ndarray, receivers: tuple[Receivers, Receivers],
+                 steps: tuple[np.ndarray, np.ndarray] | np.ndarray) -> Generator[float, None, np.ndarray]:
+    """(2, n) the CPU reference's value at `cells` (n,) from each replicate's receivers along
+    its `steps` (direction indices of plan's directions), NaN where unlit. Yields progress."""
+    from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
+    plan = replace(plan, cells=cells)
     exact = np.full((2, len(cells)), np.nan)
+    total = sum(len(part) for part in steps)
+    done = 0
     for k in range(2):
         baker = ReferenceBaker(plan, receivers[k], START_OFFSET_PIXELS * plan.pixel_size)
         try:
-            for i, index in enumerate(probe.steps[k]):
+            for index in steps[k]:
                 baker.run_direction(int(index))
-                yield (k * probe.half + i + 1) / (2 * probe.half)
+                done += 1
+                yield done / total
             numerator, w = (part.reshape(-1)[cells] for part in plan.estimator.ratio(baker.accumulated()))
         finally:
             baker.free()
         lit = w > 0.0
         exact[k, lit] = numerator[lit] / w[lit]
-    seen = np.isfinite(exact).all(axis=0) & np.isfinite(values).all(axis=0)
-    if not seen.any():
-        return None
-    floor = np.clip(values[:, seen], 0.0, 1.0) - np.clip(exact[:, seen], 0.0, 1.0)
-    return cells[seen], floor[0], floor[1]
+    return exact

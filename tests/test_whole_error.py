@@ -50,16 +50,17 @@ def spot_truth(gpu_context):
     return spot, settings, truth_at(spot, [], bake_sample_points(spot, settings), rays=8192)
 
 
-@pytest.mark.parametrize("directions", [256, 4096])
-def test_the_stated_error_is_the_whole_error_against_the_truth(spot_truth, monkeypatch, directions):
+@pytest.mark.parametrize("directions, seed", [(256, 0), (4096, 0), (4096, 1), (4096, 7)])
+def test_the_stated_error_is_the_whole_error_against_the_truth(spot_truth, monkeypatch, directions, seed):
     """At 4096 directions Spot's gather map at 48^2 is mostly floor (the twins alone state
     about a third of the measured RMSE); with the floor the stated RMSE is within 25 % of the
     measured one at both counts, and leaving the floor out (with_floor returning the twins'
-    estimate) fails the bound at 4096."""
+    estimate) fails the bound at 4096. Seeds 1 and 7 stated 0.74x and 0.68x before the
+    largest probe floors were checked again along all directions (floor_check.REFINED_SHARE)."""
     spot, settings, truth = spot_truth
 
     def measured_ratio():
-        result = bake(spot, [], replace(settings, directions=directions), use_cache=False)
+        result = bake(spot, [], replace(settings, directions=directions, seed=seed), use_cache=False)
         both = result.covered & truth.covered
         error = result.ao[both] - truth.values[both]
         measured = np.sqrt(max(np.mean(error ** 2) - truth.noise ** 2, 0.0))
