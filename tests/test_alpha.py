@@ -17,6 +17,7 @@ from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.geometry import TriangleSoup
 
 DIRS = 256
+COARSE = 32  # directions of the checks that need no accuracy
 H = 0.5  # the card's height over the floor
 
 
@@ -80,10 +81,12 @@ def test_half_alpha_card_over_a_floor_lets_half_the_light_through(gpu_context, m
     assert res.stats["alpha_faces"] > 0
     if method == "gather" and max_distance == 0.0:  # four depth taps a test: half the noise of one
         assert stats["rmse"] <= 0.6 * stochastic_sigma(DIRS), stats
-    opaque = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="off"), use_cache=False)
+    # (Coarse checks: a few directions show a solid sheet or no sheet at all.)
+    opaque = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="off", directions=COARSE),
+                  use_cache=False)
     assert opaque.ao[opaque.covered].mean() < truth - 0.3  # 'off': today's solid sheet
-    clipped = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="clip", alpha_clip=0.6),
-                   use_cache=False)
+    clipped = bake(floor(), [card(0.5)], settings(method, max_distance=max_distance, alpha="clip", alpha_clip=0.6,
+                                                  directions=COARSE), use_cache=False)
     assert clipped.ao[clipped.covered].min() > 0.99  # below the clip threshold: nothing stops the light
 
 

@@ -41,6 +41,28 @@ def test_with_floor_adds_the_shared_part_only():
     assert ee.with_floor(base, np.zeros(0), np.zeros(0), np.zeros(0)) == base
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_heavy_tailed_floor_keeps_its_tail_in_the_p99(seed):
+    """The floor is heavy-tailed (a few texels where the shadow maps miss an occluder; the
+    rocker arm at 128^2: one texel of 6949 holds a fifth of its square), and the probe's part
+    that changes with the rotation sits elsewhere too. 2 % of the texels share a floor of
+    0.01-0.03 (checked again along all directions: no rotation part), the others hold
+    independent parts of RMS 0.0035 and no floor. The stated p99 is within 25 % of the p99 the
+    exact floors give; spreading the replicates' mean instead of floor_shape's geometric mean
+    stated 0.76-0.79x."""
+    rng = np.random.default_rng(seed)
+    n, tail = 6000, 120
+    floor = np.zeros(n)
+    floor[:tail] = 0.02 * rng.uniform(0.5, 1.5, tail)
+    apart_a, apart_b = rng.normal(0.0, 0.0035, (2, n))
+    apart_a[:tail] = apart_b[:tail] = 0.0
+    base, sigma = ee.ErrorEstimate(0.001, 0.0026, 4096), np.full(n, 0.001)
+    exact = ee.with_floor(base, floor, floor, sigma)
+    stated = ee.with_floor(base, floor + apart_a, floor + apart_b, sigma)
+    assert stated.p99 >= exact.p99 / (1.0 + CALIBRATION)
+    assert stated.rmse == pytest.approx(exact.rmse, rel=0.05)
+
+
 @pytest.fixture(scope="module")
 def spot_truth(gpu_context):
     """Spot, flat, 48^2: the Embree truth at the gather's own sample points (8192 rays each)."""
