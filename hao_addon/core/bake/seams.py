@@ -14,6 +14,14 @@ import numpy as np
 from ..geometry import unit_vectors
 
 MIN_COVERAGE = 0.5
+
+
+def estimated(weight: np.ndarray, elements: bool = False) -> np.ndarray:
+    """(...) bool: the texels (or, with elements, colour-attribute elements) whose value is the
+    bake's own estimate, from their accumulated weight (...): a texel's coverage at least
+    MIN_COVERAGE (the others are grown from their neighbours, finalize_map), an element any.
+    The map's stated error covers these, and its floor check samples them."""
+    return weight > 0.0 if elements else weight >= MIN_COVERAGE
 _OFFSETS = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
 
 
@@ -89,7 +97,7 @@ def element_values(numerator: np.ndarray, weight: np.ndarray, background: float 
     """A colour attribute's values from its per-element sums (n,) (each lit corner weighs 1):
     (ao (n,) float32 in [0, 1], covered (n,) bool: sampled by a lit corner, filled: the same;
     unsampled elements hold `background`). No margins: elements have no neighbours to bleed."""
-    covered = weight > 0.0
+    covered = estimated(weight, elements=True)
     ratio = np.divide(numerator, weight, out=np.full_like(numerator, background), where=covered)
     return np.clip(ratio, 0.0, 1.0).astype(np.float32), covered, covered.copy()
 
@@ -103,7 +111,7 @@ def finalize_map(numerator: np.ndarray, coverage: np.ndarray, margin: int,
     (H, W) bool: texels with a trusted estimate, filled (H, W) bool: every texel a UV
     triangle touches plus `margin` rings). Texels outside hold `background`.
     """
-    covered = coverage >= MIN_COVERAGE
+    covered = estimated(coverage)
     ratio = np.divide(numerator, coverage, out=np.zeros_like(numerator), where=covered)
     ao = np.clip(ratio, 0.0, 1.0).astype(np.float32)
     # Erosion is the MIN_COVERAGE threshold. Dilation refills the eroded rim (at most two
