@@ -4,6 +4,7 @@ independent truth (bench/truth.py: Embree, converged), by direction count, on Sp
 arm, the bunny and fandisk, flat and smooth, in one run.
 
     .venv/bin/python bench/floor_bench.py [--meshes ...] [--size 128] [--rays 32768]
+        [--methods gather,reference,scatter] [--carry bench/results/floor_bench.json]
 
 Each map is measured against the truth that matches what its texels are:
 - the gather: the AO at each texel's sample point, where its GPU texel list put it
@@ -15,7 +16,9 @@ Smooth rows shade with Blender's smooth corner normals and Cycles' terminator of
 truth lifts its rays the same way). Per row: measured RMSE (the truth's own noise taken out)
 and p99 against the truth, the bake's stated RMSE and p99, their ratios (measured / stated),
 and the visibility floor the bake measured in it (hao_addon/floor_check.py). The reference
-runs up to 1024 directions (its rays are a Python call each). Writes floor_bench.json into the
+runs up to 1024 directions (its rays are a Python call each), and takes most of the run's
+time: --methods reruns the methods a change touches, and --carry keeps an earlier run's rows of
+the others (the file names each carried method's revision). Writes floor_bench.json into the
 output folder.
 """
 from __future__ import annotations
@@ -89,6 +92,8 @@ def main() -> None:
     ap.add_argument("--methods", default="gather,reference,scatter")
     ap.add_argument("--view-samples", type=float, default=2.0)
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
+    ap.add_argument("--carry", metavar="FILE", help="an earlier floor_bench.json whose rows of the methods not "
+                    "run now are kept (marked in 'carried'): rerun the methods a change touches")
     args = ap.parse_args()
     from hao_addon.blender.gpu_context import ensure_gpu_context
     ensure_gpu_context()
@@ -120,14 +125,35 @@ def main() -> None:
                                  **row(result, matching[method])})
                     print(json.dumps(rows[-1]), flush=True)
     import bpy
+    result = {"size": args.size, "view_samples": args.view_samples, "revision": _revision(),
+              "truth": {"rays": args.rays, "tracer": "Embree (embreex)", "meshes": truth_info},
+              "machine": {"platform": platform.platform(), "python": platform.python_version(),
+                          "blender": bpy.app.version_string},
+              "rows": rows}
+    if args.carry:
+        result = carried(result, json.loads(Path(args.carry).read_text()))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "floor_bench.json").write_text(json.dumps({
-        "size": args.size, "view_samples": args.view_samples,
-        "truth": {"rays": args.rays, "tracer": "Embree (embreex)", "meshes": truth_info},
-        "machine": {"platform": platform.platform(), "python": platform.python_version(),
-                    "blender": bpy.app.version_string},
-        "rows": rows}, indent=1) + "\n")
+    (out / "floor_bench.json").write_text(json.dumps(result, indent=1) + "\n")
+
+
+def carried(result: dict, earlier: dict) -> dict:
+    """result with the rows of `earlier` whose method it did not run, and in result["carried"]
+    each carried method's revision (the earlier file's own "carried" entries stay theirs)."""
+    ran = {r["method"] for r in result["rows"]}
+    rows = [r for r in earlier["rows"] if r["method"] not in ran]
+    before = earlier.get("carried", {})
+    origin = {m: before.get(m, earlier.get("revision", "unrecorded")) for m in sorted({r["method"] for r in rows})}
+    return {**result, "rows": result["rows"] + rows, "carried": {**origin}}
+
+
+def _revision() -> str:
+    """The checkout's short commit, with '+' when it has uncommitted changes."""
+    import subprocess
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
+                           text=True).stdout.strip()
+    return head + ("+" if dirty else "")
 
 
 if __name__ == "__main__":
