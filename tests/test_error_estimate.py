@@ -8,6 +8,7 @@ to the measurement is 0.93-0.97 on the Cycles scenes at 64 and 256 directions, s
 2 on the estimator's variance (a ratio of 1.32-1.37, or 0.66-0.69 for half) fails it."""
 from __future__ import annotations
 
+import functools
 import json
 import subprocess
 import sys
@@ -122,6 +123,16 @@ def _gather(soup, name, directions, seed=0, **kw):
                 use_cache=False)
 
 
+@functools.cache
+def _converged(name) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(converged map, its own noise's variance per texel, covered): two seeds of 4096
+    directions, baked once for every test of this module that needs them."""
+    soup = _smooth_case(name)[0]
+    high = [_gather(soup, name, 4096, seed=s) for s in (7, 8)]
+    converged = 0.5 * (high[0].ao.astype(np.float64) + high[1].ao)
+    return converged, (high[0].ao.astype(np.float64) - high[1].ao) ** 2 / 4.0, high[0].covered
+
+
 @pytest.mark.parametrize("name", ["rocker_smooth", "spot_smooth"])
 def test_estimate_matches_the_error_against_cycles_and_a_converged_bake(gpu_context, name):
     """The smooth rocker arm and Spot, gather (Auto's method here): at 64 and 256 directions
@@ -131,12 +142,10 @@ def test_estimate_matches_the_error_against_cycles_and_a_converged_bake(gpu_cont
     gather and Cycles at any direction count (shadow-map depth at texel centres) is about
     0.0025 RMSE, and the estimate says only what more directions would remove."""
     soup, cycles, cycles_var, inner = _smooth_case(name)
-    high = [_gather(soup, name, 4096, seed=s) for s in (7, 8)]
-    converged = 0.5 * (high[0].ao.astype(np.float64) + high[1].ao)
-    converged_var = (high[0].ao.astype(np.float64) - high[1].ao) ** 2 / 4.0
+    converged, converged_var, converged_covered = _converged(name)
     for directions in (64, 256, 1024):
         res = _gather(soup, name, directions)
-        mask = inner & res.covered & high[0].covered
+        mask = inner & res.covered & converged_covered
         est = ee.estimate(res.twin, mask, directions)
         own = _measured_rmse(res.ao, converged, float(converged_var[mask].mean()), mask)
         assert abs(est.rmse / own - 1.0) <= CALIBRATION, (name, directions, "converged", est.rmse, own)
@@ -154,8 +163,7 @@ def test_bake_to_a_stated_error_meets_it_and_stops_at_its_cap(gpu_context):
     stops at once and says the floor is what keeps it above: tests/test_whole_error.py.)"""
     name = "spot_smooth"
     soup, _cycles, _var, inner = _smooth_case(name)
-    high = [_gather(soup, name, 4096, seed=s) for s in (7, 8)]
-    converged = 0.5 * (high[0].ao.astype(np.float64) + high[1].ao)
+    converged = _converged(name)[0]
     target = 0.015
     res = _gather(soup, name, 8192, quality="custom", max_error=target)
     st = res.stats
