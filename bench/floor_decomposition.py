@@ -59,7 +59,7 @@ def exact_map(plan, receivers, steps) -> np.ndarray:
     return np.divide(numerator, w, out=np.full(w.shape, np.nan), where=w > 0.0)
 
 
-def decompose(soup, settings, count: int) -> dict:
+def decompose(soup, settings, count: int, dump: str = "") -> dict:
     from hao_addon.core.bake import error_estimate as ee
     from hao_addon.core.bake.plan import make_plan_steps
     from hao_addon.core.bake.targets import as_bake_target
@@ -105,6 +105,10 @@ def decompose(soup, settings, count: int) -> dict:
         ee.floor_shape = shape
     whole = 0.5 * (clip(maps[split]) + clip(maps[count])) - 0.5 * (clip(floors["full"][2]) + clip(floors["full"][3]))
     rms = lambda v: float(np.sqrt(np.mean(v ** 2)))  # noqa: E731
+    if dump:  # per-texel arrays, to try other estimates on without baking again
+        np.savez_compressed(f"{dump}_{count}.npz", probe_a=fa["probe"], probe_b=fb["probe"], full_a=fa["full"],
+                            full_b=fb["full"], refined=refined, sigma=sigma, whole=whole, twins_rmse=twins.rmse,
+                            twins_p99=twins.p99)
     return {"directions": count, "probe_directions": half, "texels": int(seen.sum()),
             "floor_proper_probe": float(np.sqrt(max(np.mean(fa["probe"] * fb["probe"]), 0.0))),
             "floor_proper_full": float(np.sqrt(max(np.mean(product), 0.0))),
@@ -121,6 +125,7 @@ def main() -> None:
     ap.add_argument("--shading", choices=("flat", "smooth"), default="flat")
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--directions", type=int, nargs="+", default=[4096, 16384])
+    ap.add_argument("--dump", default="", help="also write each count's per-texel arrays to DUMP_<count>.npz")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results" / "runs" / "floor_decomposition.json"))
     args = ap.parse_args()
     from hao_addon.blender.gpu_context import ensure_gpu_context
@@ -138,7 +143,7 @@ def main() -> None:
                             method="gather", view_samples=2.0)
     rows = []
     for count in args.directions:
-        rows.append(decompose(soup, settings, count))
+        rows.append(decompose(soup, settings, count, args.dump))
         print(json.dumps(rows[-1]), flush=True)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
