@@ -241,7 +241,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             shared["floor_sample"] = floor_sample(method, checked, baker, shared.get("floor_directions", count),
                                                   settings.seed)
         if snapshots is not None and shared["floor_sample"] is not None:
-            shared["floor_probe"] = take_probe(plan, baker, count, snapshots, shared["floor_sample"][0],
+            shared["floor_probe"] = take_probe(plan, baker, count, snapshots, shared["floor_sample"].cells,
                                                (sums_b if sums_a is None else sums_a, sums_b))
     finally:
         baker.free()
@@ -359,8 +359,8 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
     found = shared["floor_found"][1]
     if found is None:
         return result
-    cells, floor_a, floor_b = found
-    error = with_floor(result.error, floor_a, floor_b, result.error_map().reshape(-1)[cells])
+    cells, floor_a, floor_b, weight = found
+    error = with_floor(result.error, floor_a, floor_b, result.error_map().reshape(-1)[cells], weight)
     stats = {**result.stats, "error": error.as_dict()}
     target = settings.error_target
     if target > 0.0 and error.p99 > target and not error.capped:

@@ -81,6 +81,83 @@ def test_a_heavy_tailed_floor_keeps_its_tail_in_the_p99(seed):
     assert stated.rmse == pytest.approx(exact.rmse, rel=0.05)
 
 
+def test_a_stratified_floor_sample_weighs_each_texel_by_what_it_stands_for():
+    """One texel at risk of 6400 holds a floor of 0.9, checked with 2047 random others of no
+    floor: weighed by its stratum (itself alone) the floor's RMS is the population's, 0.9 /
+    sqrt(6400); counted as one of the 2048 checked it would be 0.9 / sqrt(2048), 1.8x over.
+    A weight for all alike gives numpy's percentile."""
+    n, population = 2048, 6400
+    floor = np.zeros(n)
+    floor[0] = 0.9
+    weight = np.full(n, (population - 1) / (n - 1))
+    weight[0] = 1.0
+    base = ee.ErrorEstimate(0.0005, 0.0015, 4096)
+    stated = ee.with_floor(base, floor, floor, np.full(n, 0.0005), weight)
+    assert stated.floor_rmse == pytest.approx(0.9 / np.sqrt(population), rel=1e-9)
+    assert ee.with_floor(base, floor, floor, np.full(n, 0.0005)).floor_rmse == pytest.approx(0.9 / np.sqrt(n))
+    values = np.random.default_rng(0).random(1001)
+    assert ee.weighted_percentile(values, np.full(1001, 3.0), 99) == pytest.approx(np.percentile(values, 99))
+
+
+class _RiskyBaker:
+    """A stand-in baker for floor_sample: every covered texel its own point; `risky` at risk."""
+    FRESH_DRAWS = False
+
+    def __init__(self, risky):
+        self.risky = np.asarray(risky, np.int64)
+
+    def at_risk_cells(self):
+        return self.risky
+
+    def sample_receivers(self, cells, draw=0):
+        from hao_addon.core.bake.receivers import Receivers
+        k = len(cells)
+        return Receivers(np.zeros((k, 3)), np.tile([0.0, 0.0, 1.0], (k, 1)), np.tile([0.0, 0.0, 1.0], (k, 1)),
+                         np.ones(k), np.asarray(cells, np.int64))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_floor_check_checks_every_texel_at_risk(seed):
+    """Texels at risk (the gather's with a shading normal against its face) are each checked,
+    up to a quarter of the sample, whatever the seed: the bunny's one such texel at 128^2 (0.92
+    off) was checked by chance at 1024 directions and missed at 4096 (stated 0.28x)."""
+    from hao_addon.floor_check import floor_sample, floor_texel_count
+    covered = np.ones((128, 128), bool)
+    covered[:, :10] = False
+    wanted = floor_texel_count(1024)
+    sample = floor_sample("gather", covered, _RiskyBaker([3, 15819, 16020]), 1024, seed)
+    assert len(sample.cells) == wanted and sample.cells[sample.at_risk].tolist() == [15819, 16020]
+    assert sample.population == (2, int(covered.sum()) - 2)  # texel 3 is not covered
+    weights = sample.weights(np.ones(len(sample.cells), bool))
+    assert np.all(weights[sample.at_risk] == 1.0) and weights.sum() == pytest.approx(covered.sum())
+    many = floor_sample("gather", covered, _RiskyBaker(np.flatnonzero(covered.ravel())[::7]), 1024, seed)
+    assert many.at_risk.sum() == wanted // 4 and len(many.cells) == wanted
+
+
+def test_the_gather_finds_its_texels_at_risk(gpu_context, monkeypatch):
+    """Two quads of a plane shaded with normals that point below it (0.6, 0, -0.8): the gather
+    finds their 32 texels at risk (as the CPU raster's receivers have them), and its bake's
+    floor check checks each."""
+    import hao_addon.bake as bake_module
+    from hao_addon.core.bake.plan import make_plan_steps
+    from hao_addon.core.bake.targets import as_bake_target
+    from hao_addon.core.steps import drain
+    from hao_addon.floor_check import floor_sample
+    plane = scenes.grid_plane(2.0, 8)
+    normals = np.tile([0.0, 0.0, 1.0], (len(plane.positions), 3, 1))
+    for cell in (10, 37):
+        normals[[cell, cell + 64]] = [0.6, 0.0, -0.8]
+    plane = replace(plane, normals=normals)
+    settings = BakeSettings(size=32, margin=0, normals="mesh", method="gather", directions=256)
+    cpu = drain(make_plan_steps(as_bake_target(plane, "image", None, None), [], settings)).receivers()
+    expected = np.unique(cpu.texel[np.einsum("ij,ij->i", cpu.shading, cpu.geometric) < 0.0])
+    samples = []
+    monkeypatch.setattr(bake_module, "floor_sample", lambda *a: samples.append(floor_sample(*a)) or samples[-1])
+    bake(plane, [], settings, use_cache=False)
+    assert len(expected) == 32 and samples[0].cells[samples[0].at_risk].tolist() == expected.tolist()
+    assert samples[0].population[0] == 32
+
+
 @pytest.fixture(scope="module")
 def spot_truth(gpu_context):
     """Spot, flat, 48^2: the Embree truth at the gather's own sample points (8192 rays each)."""

@@ -494,6 +494,25 @@ class GatherBaker(LightViewBaker):
             lift = util.texture_to_numpy(self.entry_lift, np.float32).reshape(-1, 4)[:n][keep, :3].astype(np.float64)
         return Receivers(position[:, :3], geometric, shading, position[:, 3], flat[keep], lift)
 
+    def at_risk_cells(self) -> np.ndarray:
+        """(k,) sorted flat texel indices with an entry whose shading normal points against its
+        face (most of its hemisphere below the surface, each such direction tested from a
+        terminator lift or counted occluded): rare, and there the depth maps can miss what an
+        exact ray finds (the bunny at 128^2, smooth: its one such texel read 0.92 where the
+        exact AO is 0). The floor check checks each of them (floor_check.floor_sample)."""
+        if self.receivers is not None:
+            r = self.receivers
+            inverted = np.einsum("ij,ij->i", r.shading, r.geometric) < 0.0
+            return np.unique(r.texel[inverted & (r.inv_s > 0.0)])
+        if not self.shading_layout:
+            return np.zeros(0, np.int64)
+        n, size = self.entry_count, self.plan.settings.size
+        normal = util.texture_to_numpy(self.entry_normal, np.float32).reshape(-1, 4)[:n]
+        inverted = np.flatnonzero(np.einsum("ij,ij->i", octahedral_decode(normal[:, :2]),
+                                            octahedral_decode(normal[:, 2:])) < 0.0)
+        texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:n][inverted]
+        return np.unique((texel >> 16).astype(np.int64) * size + (texel & 0xFFFF))
+
     def restart(self) -> None:
         """Zero the sums (after accumulated()): the next directions are summed apart."""
         self._test_pending_views()

@@ -107,11 +107,13 @@ def estimate(twin: np.ndarray, covered: np.ndarray, directions: int, capped: boo
 FLOOR_QUANTILES = 64
 
 
-def with_floor(error: ErrorEstimate, floor_a: np.ndarray, floor_b: np.ndarray, sigma: np.ndarray) -> ErrorEstimate:
+def with_floor(error: ErrorEstimate, floor_a: np.ndarray, floor_b: np.ndarray, sigma: np.ndarray,
+               weight: np.ndarray | None = None) -> ErrorEstimate:
     """The whole error: `error` (the twins') with the visibility floor measured at sampled
     texels. floor_a, floor_b: (n,) each replicate's value there minus the exact value along its
     own directions (hao_addon/floor_check.py); sigma: (n,) the twins' local RMS there (the
-    direction noise each texel has on top).
+    direction noise each texel has on top); weight: (n,) how many covered texels each stands
+    for (a stratified sample: floor_check.FloorSample), or None for a plain random sample.
 
     The floor proper is the part of floor_a and floor_b that their independent rotations share:
     its mean square is the mean of floor_a * floor_b (the parts that change with the rotation
@@ -126,18 +128,30 @@ def with_floor(error: ErrorEstimate, floor_a: np.ndarray, floor_b: np.ndarray, s
     floor_a, floor_b = np.asarray(floor_a, np.float64), np.asarray(floor_b, np.float64)
     if floor_a.size == 0:
         return error
-    square = max(float(np.mean(floor_a * floor_b)), 0.0)
+    weight = np.ones(floor_a.size) if weight is None else np.asarray(weight, np.float64)
+    square = max(float(np.average(floor_a * floor_b, weights=weight)), 0.0)
     floor = floor_shape(floor_a, floor_b)
-    mean_square = float(np.mean(floor ** 2))
+    mean_square = float(np.average(floor ** 2, weights=weight))
     floor = floor * (np.sqrt(square / mean_square) if mean_square > 0.0 else 0.0)
     sigma = np.asarray(sigma, np.float64)
     z = _normal_quantiles(FLOOR_QUANTILES)
-    without = np.percentile(np.abs(sigma[:, None] * z[None]), 99)
+    spread = np.repeat(weight, z.size)  # each texel's FLOOR_QUANTILES draws weigh as it does
+    without = weighted_percentile(np.abs(sigma[:, None] * z[None]).ravel(), spread, 99)
     noise = sigma * (error.p99 / without if without > 0.0 else 1.0)  # the twins' p99 calibrates the noise
-    p99 = np.percentile(np.abs(floor[:, None] + noise[:, None] * z[None]), 99)
+    p99 = weighted_percentile(np.abs(floor[:, None] + noise[:, None] * z[None]).ravel(), spread, 99)
     return replace(error, rmse=float(np.sqrt(error.rmse ** 2 + square)), p99=float(max(p99, error.p99)),
-                   floor_rmse=float(np.sqrt(square)), floor_p99=float(np.percentile(np.abs(floor), 99)),
+                   floor_rmse=float(np.sqrt(square)), floor_p99=weighted_percentile(np.abs(floor), weight, 99),
                    floor_texels=int(floor.size))
+
+
+def weighted_percentile(values: np.ndarray, weight: np.ndarray, q: float) -> float:
+    """The q-th percentile of (n,) values each weighing weight (n,): numpy's linear one where
+    all weigh alike (its interpolation between the order statistics at rank q/100 (n - 1))."""
+    order = np.argsort(values, kind="stable")
+    v, w = values[order], weight[order]
+    rank = np.cumsum(w) - 0.5 * w  # each value at the middle of its weight
+    rank = (rank - rank[0]) / max(rank[-1] - rank[0], 1e-300) * (len(v) - 1)
+    return float(np.interp(q / 100.0 * (len(v) - 1), rank, v))
 
 
 def floor_shape(floor_a: np.ndarray, floor_b: np.ndarray) -> np.ndarray:
