@@ -32,16 +32,16 @@ import numpy as np  # noqa: E402
 def replicate_maps(plan, baker, count: int) -> dict[int, np.ndarray]:
     """{step: (cells,) partial map value} after each replicate's probe and at each one's end."""
     from hao_addon.core.directions import probe_half, replicate_sizes
-    from hao_addon.floor_check import probe_map
+    from hao_addon.core.bake.probe_snapshot import MapSnapshot
     split, half = replicate_sizes(count)[0], probe_half(count)
     maps = {}
     for i in range(count):
         if i in (half, split, split + half):
-            maps[i] = probe_map(plan.estimator, baker.accumulated()).reshape(-1).astype(np.float64)
+            maps[i] = MapSnapshot.of(plan.estimator, baker.accumulated()).values.reshape(-1).astype(np.float64)
             if i == split:
                 baker.restart()
         baker.run_direction(i)
-    maps[count] = probe_map(plan.estimator, baker.accumulated()).reshape(-1).astype(np.float64)
+    maps[count] = MapSnapshot.of(plan.estimator, baker.accumulated()).values.reshape(-1).astype(np.float64)
     return maps
 
 

@@ -13,7 +13,6 @@ import math
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field, replace
-from functools import partial
 from typing import Callable, Generator
 
 import numpy as np
@@ -27,7 +26,7 @@ from .core.bake.projection import HighToLow
 from .core.bake.estimators import BENT_NORMALS
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
     replicate_twin, with_floor, directions_for
-from .floor_check import floor_sample, floor_steps, probe_map, probe_steps, take_probe
+from .floor_check import floor_sample, floor_steps, probe_steps, take_probe
 from .replicates import replicate_sums_steps
 from .core.bake.seams import dilate, element_values, estimated, finalize_map, finalize_vectors
 from .core.bake.settings import QUALITY_CAPS, BakeSettings
@@ -227,8 +226,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         count = settings.directions
         best = shared["floor_probe"].half if shared.get("floor_probe") else 0
         snapshots = probe_steps(method, count, best)
-        sums_a, sums_b = yield from replicate_sums_steps(baker, count, share, snapshots,
-                                                         partial(probe_map, plan.estimator))
+        sums_a, sums_b = yield from replicate_sums_steps(baker, count, share, snapshots)
         # The map is the replicates' mean (each receiver weighs 1 in each).
         sums = sums_b if sums_a is None else sums_a + sums_b
         gpu_stats = dict(baker.stats)

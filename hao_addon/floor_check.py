@@ -32,8 +32,8 @@ from typing import Generator
 import numpy as np
 
 from .core.bake.abilities import declaration
-from .core.bake.estimators import Estimator
 from .core.bake.plan import BakePlan
+from .core.bake.probe_snapshot import sums_value
 from .core.bake.receivers import Receivers
 from .core.bake.verify import pick_cells
 from .core.directions import probe_half, replicate_sizes
@@ -172,25 +172,19 @@ def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed:
     return FloorSample(held, tuple(r.subset(np.isin(r.texel, held)) for r in draws), at_risk, population)
 
 
-def probe_map(estimator: Estimator, sums: np.ndarray) -> np.ndarray:
-    """(*output_shape) float32: a snapshot's partial map value, NaN where unlit. One channel
-    whatever the estimator's (eight with bent normals): the probe keeps two whole-map snapshots
-    to the bake's end, 67 MB each at 4096^2 (134 MB as float32 sums, 268 MB as float64)."""
-    numerator, w = estimator.ratio(sums)
-    lit = w > 0.0
-    return np.where(lit, np.divide(numerator, w, out=np.zeros(w.shape), where=lit), np.nan).astype(np.float32)
-
-
 def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.ndarray,
                sums: tuple[np.ndarray, np.ndarray]) -> FloorProbe:
-    """The FloorProbe of a round from its snapshots (probe_steps, each a probe_map) and its
-    replicates' whole sums (replicate_sums_steps) at `cells`."""
+    """The FloorProbe of a round from its snapshots (probe_steps, each a
+    core/bake/probe_snapshot one) and its replicates' whole sums (replicate_sums_steps) at
+    `cells` (sorted)."""
     split = replicate_sizes(count)[0]
     first, second = sorted(snapshots)
     half = first
     order = np.asarray(getattr(baker, "direction_order", np.arange(count)))
-    values = np.stack([snapshots[step].reshape(-1)[cells].astype(np.float64) for step in (first, second)])
-    full_values = np.stack([probe_map(plan.estimator, part).reshape(-1)[cells].astype(np.float64) for part in sums])
+    values = np.stack([snapshots[step].at(cells) for step in (first, second)])
+    channels = plan.estimator.channel_count
+    full_values = np.stack([sums_value(plan.estimator, part.reshape(-1, channels)[cells]).astype(np.float64)
+                            for part in sums])
     return FloorProbe(plan, half, np.stack([order[:half], order[split:split + half]]), values,
                       (order[:split], order[split:count]), full_values)
 

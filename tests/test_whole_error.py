@@ -158,6 +158,35 @@ def test_the_gather_finds_its_texels_at_risk(gpu_context, monkeypatch):
     assert samples[0].population[0] == 32
 
 
+@pytest.mark.parametrize("method", ["gather", "scatter"])
+def test_a_probe_snapshot_is_the_partial_map_at_its_cells(gpu_context, method):
+    """What the floor check keeps of a partial map (the gather: each entry's value, summed per
+    texel only at the checked texels) is the partial map at those texels, four sample points a
+    texel (several entries each) and texels no direction lit (NaN) included."""
+    from hao_addon.bakers import baker_for
+    from hao_addon.core.bake.plan import make_plan_steps
+    from hao_addon.core.bake.probe_snapshot import MapSnapshot
+    from hao_addon.core.bake.targets import as_bake_target
+    from hao_addon.core.steps import drain
+    from hao_addon.replicates import probe_snapshot
+    spot = obj_soup(ROOT / "samples" / "spot.obj")
+    settings = BakeSettings(size=48, margin=0, normals="face", method=method, directions=64,
+                            samples_per_texel=4 if method == "gather" else 1)
+    plan = drain(make_plan_steps(as_bake_target(spot, "image", None, None), [], settings))
+    baker = baker_for(method)(plan)
+    try:
+        for index in range(3):
+            baker.run_direction(index)
+        kept = probe_snapshot(baker)
+        whole = MapSnapshot.of(plan.estimator, baker.accumulated())
+    finally:
+        baker.free()
+    cells = np.sort(np.random.default_rng(0).choice(48 * 48, size=600, replace=False))
+    expected = whole.at(cells)
+    assert np.isnan(expected).any() and np.isfinite(expected).sum() > 100
+    np.testing.assert_allclose(kept.at(cells), expected, rtol=0, atol=1e-6)
+
+
 @pytest.fixture(scope="module")
 def spot_truth(gpu_context):
     """Spot, flat, 48^2: the Embree truth at the gather's own sample points (8192 rays each)."""
