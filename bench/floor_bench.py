@@ -95,6 +95,7 @@ def main() -> None:
     ap.add_argument("--carry", metavar="FILE", help="an earlier floor_bench.json whose rows of the methods not "
                     "run now are kept (marked in 'carried'): rerun the methods a change touches")
     args = ap.parse_args()
+    revision = _revision()  # the code that runs: taken before the run, which may outlast a commit
     from hao_addon.blender.gpu_context import ensure_gpu_context
     ensure_gpu_context()
     from hao_addon.bake import bake
@@ -125,7 +126,7 @@ def main() -> None:
                                  **row(result, matching[method])})
                     print(json.dumps(rows[-1]), flush=True)
     import bpy
-    result = {"size": args.size, "view_samples": args.view_samples, "revision": _revision(),
+    result = {"size": args.size, "view_samples": args.view_samples, "revision": revision,
               "truth": {"rays": args.rays, "tracer": "Embree (embreex)", "meshes": truth_info},
               "machine": {"platform": platform.platform(), "python": platform.python_version(),
                           "blender": bpy.app.version_string},
