@@ -137,6 +137,16 @@ class FloorSample:
         return FloorSample(cells, tuple(r.subset(np.isin(r.texel, cells)) for r in self.receivers),
                            self.at_risk[keep], self.population)
 
+    def thinning(self, count: int, rng: np.random.Generator) -> np.ndarray | None:
+        """(k,) sorted indices into cells of a sample of `count` cells: every texel at risk and
+        random others (a random part of the random stratum is a random sample of it too); None
+        where the sample holds no more than `count`."""
+        if len(self.cells) <= count:
+            return None
+        risky, others = np.flatnonzero(self.at_risk), np.flatnonzero(~self.at_risk)
+        chosen = rng.choice(others, size=min(max(count - len(risky), 0), len(others)), replace=False)
+        return np.sort(np.concatenate([risky, chosen]))
+
 
 def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed: int) -> FloorSample | None:
     """A FloorSample of floor_texel_count(directions) covered cells, taken from a live baker of
@@ -167,12 +177,9 @@ def floor_sample(method: str, covered: np.ndarray, baker, directions: int, seed:
     first = baker.sample_receivers(cells, 0)  # the gather's is a readback of its whole texel list: once
     draws = (first, baker.sample_receivers(cells, 1) if baker.FRESH_DRAWS else first)
     held = np.intersect1d(draws[0].texel, draws[1].texel)
-    at_risk = np.isin(held, risky)
-    if len(held) > wanted:
-        keep = rng.choice(np.flatnonzero(~at_risk), size=wanted - int(at_risk.sum()), replace=False)
-        held = np.sort(np.concatenate([held[at_risk], held[keep]]))
-        at_risk = np.isin(held, risky)
-    return FloorSample(held, tuple(r.subset(np.isin(r.texel, held)) for r in draws), at_risk, population)
+    sample = FloorSample(held, draws, np.isin(held, risky), population)
+    keep = sample.thinning(wanted, rng)
+    return sample.part(np.arange(len(held)) if keep is None else keep)
 
 
 def take_probe(plan: BakePlan, baker, count: int, snapshots: dict, cells: np.ndarray,
@@ -211,11 +218,8 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int
     for (FloorSample.weights). None where no cell is lit in both. Yields progress in [0, 1]."""
     values, full_values = probe.values, probe.full_values
     wanted = floor_texel_count(directions)
-    if len(sample.cells) > wanted:  # the sample is random, so a random part of it is a sample too
-        others = np.flatnonzero(~sample.at_risk)
-        rest = max(wanted - int(sample.at_risk.sum()), 0)
-        keep = np.sort(np.concatenate([np.flatnonzero(sample.at_risk), np.random.default_rng(
-            [directions, FLOOR_SEED]).choice(others, size=min(rest, len(others)), replace=False)]))
+    keep = sample.thinning(wanted, np.random.default_rng([directions, FLOOR_SEED]))
+    if keep is not None:
         sample, values, full_values = sample.part(keep), values[:, keep], full_values[:, keep]
     cells, receivers = sample.cells, sample.receivers
     exact = yield from relay(_exact_steps(probe.plan, cells, receivers, probe.steps), lambda f: 0.5 * f)

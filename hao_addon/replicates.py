@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from typing import Generator
 
-from .core.bake.probe_snapshot import MapSnapshot
+from .core.bake.probe_snapshot import EntrySnapshot, MapSnapshot
 from .core.directions import replicate_sizes
 
 
-def probe_snapshot(baker) -> "MapSnapshot":
+def probe_snapshot(baker) -> MapSnapshot | EntrySnapshot:
     """The baker's partial map as the floor check keeps it: its own probe_snapshot() where it
     has a cheaper one (the gather's entries), else a MapSnapshot of its sums."""
     own = getattr(baker, "probe_snapshot", None)
