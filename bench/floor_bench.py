@@ -67,13 +67,13 @@ def area_truth(soup, size: int, rays: int, shading: bool, terminator_offset: flo
     return Truth(values, covered, t.noise * float(np.sqrt(np.mean(1.0 / cover[covered]))))  # c points: sigma / sqrt(c)
 
 
-def truths(soup, settings, rays: int) -> dict:
-    """The matching truth of each method (see the module docstring)."""
+def truths(soup, settings, rays: int, methods: tuple[str, ...]) -> dict:
+    """The matching truth of each of `methods` (see the module docstring)."""
     smooth = soup.normals is not None
-    out = {"gather": truth_at(soup, [], bake_sample_points(soup, settings), rays=rays),
-           "reference": truth_at(soup, [], reference_sample_points(soup, settings), rays=rays)}
-    out["scatter"] = area_truth(soup, settings.size, rays, smooth, settings.terminator_offset)
-    return out
+    make = {"gather": lambda: truth_at(soup, [], bake_sample_points(soup, settings), rays=rays),
+            "reference": lambda: truth_at(soup, [], reference_sample_points(soup, settings), rays=rays),
+            "scatter": lambda: area_truth(soup, settings.size, rays, smooth, settings.terminator_offset)}
+    return {method: make[method]() for method in methods}
 
 
 def row(result, truth: Truth) -> dict:
@@ -118,7 +118,7 @@ def main() -> None:
             settings = BakeSettings(size=args.size, margin=0, normals="mesh" if shading == "smooth" else "face",
                                     view_samples=args.view_samples)
             start = time.perf_counter()
-            matching = truths(soup, settings, args.rays)
+            matching = truths(soup, settings, args.rays, tuple(args.methods.split(",")))
             truth_info[name] = {m: {"texels": int(t.covered.sum()), "noise_rmse": t.noise} for m, t in matching.items()}
             truth_info[name]["seconds"] = time.perf_counter() - start
             print(f"truths of {name}: {truth_info[name]}", flush=True)

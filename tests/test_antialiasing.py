@@ -180,3 +180,25 @@ def test_area_points_are_uniform_over_the_covered_part_of_their_texel():
     np.testing.assert_allclose(local[:, 0].mean(axis=0), [0.5, 0.5], atol=4 * np.sqrt(1 / 12 / n))
     # Uniform over the lower triangle of the unit square: mean (2/3, 1/3).
     np.testing.assert_allclose(local[:, 1:].mean(axis=0), [[2 / 3, 1 / 3]] * 3, atol=4 * np.sqrt(1 / 18 / n))
+
+
+def test_area_points_are_stratified_in_a_texel_covered_whole():
+    """In a wholly covered texel, texel_area_points puts each of 4 points in a quarter of its
+    own (uv_raster.area_strata), so their mean varies less than 4 independent uniform points'
+    (variance 1/12/4 = 1/48 per axis; stratified in 2 x 2 cells: 1/192). The mixture stays
+    uniform: the points' mean is the texel's centre."""
+    from hao_addon.core.bake.uv_raster import texel_area_points
+    whole = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]]])
+    size, cells, draws = 2, np.array([0, 1, 2, 3]), 300
+    means = []
+    for seed in range(draws):
+        face, bary = texel_area_points(whole, size, cells, seed, points=4)
+        assert (face >= 0).all()
+        xy = np.einsum("npk,npkd->npd", bary, whole[face]) * size
+        local = xy - np.floor(xy)
+        quarter = (local[..., 0] >= 0.5).astype(int) + 2 * (local[..., 1] >= 0.5)
+        assert (np.sort(quarter, axis=1) == [0, 1, 2, 3]).all()  # one point a quarter
+        means.append(local.mean(axis=1))
+    means = np.concatenate(means)  # (draws * cells, 2)
+    assert means.var(axis=0).max() < 1.5 / 192  # independent points: 1/48 = 4/192
+    np.testing.assert_allclose(means.mean(axis=0), [0.5, 0.5], atol=4 * np.sqrt(1 / 192 / len(means)))

@@ -86,12 +86,25 @@ def interior_mask(face: np.ndarray, hits: np.ndarray, rings: int = 2) -> np.ndar
 AREA_FACE_BLOCK = 4096
 
 
+def area_strata(points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cells of the unit texel, one per point: a side x side grid when `points` is a square,
+    else `points` vertical strips. Returns (origin (points, 2), extent (2,)) in texel units."""
+    side = int(round(np.sqrt(points)))
+    cols, rows = (side, side) if side * side == points else (points, 1)
+    k = np.arange(points)
+    extent = np.array([1.0 / cols, 1.0 / rows])
+    return np.stack([k % cols, k // cols], axis=1) * extent, extent
+
+
 def texel_area_points(uvs: np.ndarray, size: int, cells: np.ndarray, seed: int, points: int = 1, tries: int = 8
                       ) -> tuple[np.ndarray, np.ndarray]:
-    """`points` points per texel of `cells`, each uniform over the part of the texel that UV
+    """`points` points per texel of `cells`, together uniform over the part of the texel that UV
     triangles cover (a texel-area average's random sample: the scatter's floor check,
-    hao_addon/floor_check.py): `tries` uniform points for each, the first one inside a
-    triangle kept (the first triangle in order, as texel_surface_samples picks).
+    hao_addon/floor_check.py): `tries` points for each, the first one inside a triangle kept
+    (the first triangle in order, as texel_surface_samples picks). Each point's first try is
+    uniform in a cell of its own (area_strata), so a wholly covered texel's points are
+    stratified and their mean varies less; later tries are uniform over the texel, so where a
+    cell is only partly covered the points' mixture stays uniform over the covered part.
 
     uvs: (F, 3, 2) UV corners in [0, 1]; cells: (n,) distinct flat texel indices y * size + x.
     Returns (face (n, points) int64, -1 where no try landed on a triangle; bary (n, points, 3)
@@ -99,7 +112,10 @@ def texel_area_points(uvs: np.ndarray, size: int, cells: np.ndarray, seed: int, 
     cells = np.asarray(cells, np.int64)
     n, m = len(cells), points * tries
     rng = np.random.default_rng([seed, size, n, points])
-    tries_uv = (np.stack([cells % size, cells // size], axis=1)[:, None, :] + rng.random((n, m, 2))) / size
+    local = rng.random((n, points, tries, 2))
+    origin, extent = area_strata(points)
+    local[:, :, 0] = origin + extent * local[:, :, 0]  # each point's first try in its own cell
+    tries_uv = (np.stack([cells % size, cells // size], axis=1)[:, None, :] + local.reshape(n, m, 2)) / size
     best = np.full((n, m), np.iinfo(np.int64).max)  # the first triangle containing each try
     bary = np.zeros((n, m, 3))
     slot = np.full(size * size, -1, np.int64)
