@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import bpy  # noqa: E402,F401 - the GPU context and mathutils
 
 from hao_addon.bake import bake  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 from hao_addon.core.bake.alpha import SoupAlpha  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.geometry import TriangleSoup  # noqa: E402

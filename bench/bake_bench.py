@@ -44,7 +44,7 @@ from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 from hao_addon.gpu.bake_gather import VIEWS_PER_DISPATCH  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tools"))
@@ -108,7 +108,7 @@ def hao_runs(soup, size, method, directions_list, view_samples=2.0, high_to_low=
                                 margin=0, **settings), use_cache=False, high_to_low=high_to_low)
     for d in directions_list:
         # margin=0 as in cycles_bake: neither grows islands (error is measured inside them).
-        dt, res = median_seconds(lambda: bake(
+        dt, res = median_seconds(lambda d=d: bake(
             soup, [], BakeSettings(size=size, directions=d, method=method, view_samples=view_samples, margin=0,
                                    **settings), use_cache=False, high_to_low=high_to_low))
         out.append((d, dt, res.ao))

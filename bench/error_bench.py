@@ -35,14 +35,14 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
-import bpy  # noqa: E402
+import bpy  # noqa: E402, F401 - Blender first: its gpu module needs bpy loaded
 import numpy as np  # noqa: E402
 
 import shading_scenes as cases  # noqa: E402
 import hao_addon.bake as bake_module  # noqa: E402
 import hao_addon.core.directions as directions_module  # noqa: E402
 from hao_addon.bake import bake  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 
 MESHES = ["rocker_smooth", "spot_smooth", "bunny_smooth"]

@@ -101,7 +101,7 @@ def main() -> None:
                     "run now are kept (marked in 'carried'): rerun the methods a change touches")
     args = ap.parse_args()
     revision = _revision()  # the code that runs: taken before the run, which may outlast a commit
-    from hao_addon.blender.gpu_context import ensure_gpu_context
+    from hao_addon.gpu.context import ensure_gpu_context
     ensure_gpu_context()
     from hao_addon.bake import bake
     from hao_addon.core.bake.settings import BakeSettings

@@ -128,7 +128,7 @@ def main() -> None:
     ap.add_argument("--dump", default="", help="also write each count's per-texel arrays to DUMP_<count>.npz")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results" / "runs" / "floor_decomposition.json"))
     args = ap.parse_args()
-    from hao_addon.blender.gpu_context import ensure_gpu_context
+    from hao_addon.gpu.context import ensure_gpu_context
     ensure_gpu_context()
     from hao_addon.core.bake.settings import BakeSettings
     from hao_addon.core.geometry import smooth_vertex_normals

@@ -43,7 +43,7 @@ from hao_addon.core.objfile import obj_soup  # noqa: E402
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
 from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600
 TABLE1 = ViewAOSettings(rays=32, grid=256, scale=2, filter_size=16)

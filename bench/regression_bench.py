@@ -35,7 +35,7 @@ import json, sys, time
 import numpy as np
 import bpy
 from hao_addon.bake import HighToLow, bake
-from hao_addon.blender.gpu_context import ensure_gpu_context
+from hao_addon.gpu.context import ensure_gpu_context
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.geometry import TriangleSoup
 inputs, out, repeats = sys.argv[-3], sys.argv[-2], int(sys.argv[-1])

@@ -38,7 +38,7 @@ from hao_addon.core.proxies.lloyd import lloyd_clusters, sphere_proxies, vertex_
 from hao_addon.core.reference import build_bvh, reference_accessibility  # noqa: E402
 from hao_addon.core.hao.view_scene import object_from_soup  # noqa: E402
 from hao_addon.core.hao.view_settings import ViewAOSettings  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 WIDTH, HEIGHT = 800, 600
 METHODS = ("hao", "near", "far", "near+far", "hao+far")
@@ -72,7 +72,7 @@ def sync_numpy(quick):
             cl = lloyd_clusters(verts, w, k, max_iterations=20 if nv > 100_000 else 100)
             cluster_s = time.perf_counter() - t
             moved = verts * 1.01
-            ms = timeit(lambda: sphere_proxies(moved, cl.labels, w, k), 9)
+            ms = timeit(lambda moved=moved, cl=cl, w=w, k=k: sphere_proxies(moved, cl.labels, w, k), 9)
             rows.append(dict(vertices=len(verts), k=k, sync_ms=ms, clustering_s=cluster_s, iterations=cl.iterations))
             print(f"  sync numpy {len(verts):8,d} verts K={k:5d}: {ms:6.2f} ms/frame "
                   f"(Lloyd {cluster_s:.2f} s, {cl.iterations} it)", flush=True)

@@ -16,6 +16,6 @@ signal.signal(signal.SIGINT, _stop_during_startup)
 signal.signal(signal.SIGTERM, _stop_during_startup)
 
 from .cli import main  # noqa: E402
-from .cli_io import exit_process  # noqa: E402
+from .cli.io import exit_process  # noqa: E402
 
 exit_process(main())

@@ -18,7 +18,7 @@ def baker_for(method: str):
         return ReferenceBaker
     if method not in BAKE_METHODS:
         raise ValueError(f"unknown bake method '{method}', expected one of {BAKE_METHODS}")
-    from .blender.gpu_context import ensure_gpu_context
+    from .gpu.context import ensure_gpu_context
     ensure_gpu_context()  # importing the GPU passes needs a GPU context
     if method == "scatter":
         from .gpu.bake_scatter import ScatterBaker
@@ -45,7 +45,7 @@ def ray_caster_for(method: str):
         import bpy  # noqa: F401 - the bpy module makes mathutils (the CPU cast's BVH) importable
         from .core.bake.projection import project_steps
         return project_steps
-    from .blender.gpu_context import ensure_gpu_context
+    from .gpu.context import ensure_gpu_context
     ensure_gpu_context()
     from .gpu.bake_ray_cast import project_steps
     return project_steps

@@ -19,7 +19,7 @@ def render_camera_ao(scene: bpy.types.Scene, camera: bpy.types.Object, width: in
     """(H, W, 4) float32 RGBA, row 0 at the bottom: accessibility in RGB (1 = open), alpha 1
     on geometry and 0 on background (whose RGB is 1). `renderer`: a HaoRenderer to reuse
     (its skips then apply across calls); by default a temporary one."""
-    from .blender.gpu_context import ensure_gpu_context
+    from .gpu.context import ensure_gpu_context
     from .gpu.hao_renderer import HaoRenderer
     from .gpu.util import check_render_limits, texture_to_numpy
 

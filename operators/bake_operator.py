@@ -4,19 +4,31 @@
 from __future__ import annotations
 
 import time
+import traceback
 
 import bpy
 
 from ..hao_addon.blender.bake_job import BakeJob
 from ..hao_addon.blender.color_attributes import AO_ATTRIBUTE
 from ..hao_addon.core.errors import UserInputError
-from ..hao_addon.blender.gpu_context import GPUUnavailableError
+from ..hao_addon.gpu.context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
 
-# Errors a user can act on: reported, never raised into Blender's console.
-USER_ERRORS = (UserInputError, GPUUnavailableError, ShaderCompileError, ValueError, OSError, KeyError, RuntimeError)
+# Errors a user can act on: the project's own types (and the file system's): reported in one
+# line. Anything else is a bug: reported as an internal error, its traceback printed to
+# Blender's system console (internal_error), the scene left as it was.
+USER_ERRORS = (UserInputError, GPUUnavailableError, ShaderCompileError, OSError)
 # Wall time of GPU work per modal tick: short enough to keep the UI responsive.
 TICK_BUDGET_S = 0.1
+
+
+def internal_error(exc: BaseException) -> str:
+    """The one-line report of an error that is not the user's: its type and last line, and
+    where the traceback went (printed here to Blender's system console)."""
+    traceback.print_exception(exc)
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    return (f"Bake AO: internal error ({type(exc).__name__}: {lines[-1] if lines else ''}); "
+            f"the traceback is in the system console (Window > Toggle System Console); please report it")
 
 
 def bake_targets(context) -> list:
@@ -136,12 +148,19 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         except USER_ERRORS as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
+        except Exception as exc:  # a bug: reported as one, the scene as it was
+            self.report({'ERROR'}, internal_error(exc))
+            return {'CANCELLED'}
         try:
             job.run()
             job.commit()
         except USER_ERRORS as exc:
             job.cancel()
             self.report({'ERROR'}, f"Bake AO failed: {exc}" + (f" ({job.written_note()})" if job.written else ""))
+            return {'CANCELLED'}
+        except Exception as exc:
+            job.cancel()
+            self.report({'ERROR'}, internal_error(exc))
             return {'CANCELLED'}
         except BaseException:
             job.cancel()
@@ -156,6 +175,9 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
             job = self._make_job(context)
         except USER_ERRORS as exc:
             self.report({'ERROR'}, str(exc))
+            return {'CANCELLED'}
+        except Exception as exc:
+            self.report({'ERROR'}, internal_error(exc))
             return {'CANCELLED'}
         wm = context.window_manager
         self._runner = ModalBakeRunner(job, wm, context.workspace)
@@ -176,6 +198,10 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         except USER_ERRORS as exc:
             self._stop(context, cancelled=True)
             self.report({'ERROR'}, f"Bake AO failed: {exc}")
+            return {'CANCELLED'}
+        except Exception as exc:
+            self._stop(context, cancelled=True)
+            self.report({'ERROR'}, internal_error(exc))
             return {'CANCELLED'}
         if done:
             job = self._runner.job

@@ -33,7 +33,7 @@ class RENDER_OT_hao_render_ao(bpy.types.Operator):
         from ..hao_addon.blender.view_scene import region_box
         from ..hao_addon.core.errors import UserInputError
         from ..hao_addon.core.imageio import check_writable, write_ao_file
-        from ..hao_addon.blender.gpu_context import GPUUnavailableError
+        from ..hao_addon.gpu.context import GPUUnavailableError
         from ..hao_addon.render_ao import render_camera_ao
 
         scene = context.scene

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -26,6 +27,23 @@ except ImportError:  # the numpy tier alone
     bpy = None
 
 # Test files of the numpy floor (hao_addon/core): they import no bpy, gpu or mathutils.
+def cli_env(cwd: Path | None = None, **extra: str) -> dict:
+    """The environment a child `python -m hao_addon` gets in tests: this checkout on its path
+    and, given a folder, its temporary files there (where tests look for leftovers)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    if cwd is not None:
+        env.update(TMPDIR=str(cwd), TEMP=str(cwd), TMP=str(cwd))
+    return {**env, **extra}
+
+
+def run_hao(args, cwd: Path | None = None, env: dict | None = None, timeout: float = 600,
+            **kw) -> subprocess.CompletedProcess:
+    """The shared command-line runner: `python -m hao_addon ARGS` as a child process, its
+    output captured as text, in `cwd` (default: the checkout) with cli_env(cwd) plus `env`."""
+    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
+                          env=cli_env(cwd, **(env or {})), cwd=cwd or ROOT, timeout=timeout, **kw)
+
+
 NUMPY_TIER = ("test_core_math.py", "test_output_files.py", "test_spheres.py", "test_unwrap.py", "test_numpy_tier.py")
 
 _EXIT_STATUS = 0
@@ -73,7 +91,7 @@ def pytest_unconfigure(config):
 
 @pytest.fixture(scope="session")
 def gpu_context():
-    from hao_addon.blender.gpu_context import ensure_gpu_context
+    from hao_addon.gpu.context import ensure_gpu_context
     ensure_gpu_context()
     return True
 

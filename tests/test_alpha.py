@@ -172,7 +172,6 @@ def test_blender_materials_let_their_alpha_through(scene, kind, through):
 
 def _card_scene(kind: str):
     """The floor under a card whose material is of `kind`; returns (floor, card, material)."""
-    import bpy
     from conftest import select_only, soup_to_object
     floor_obj = soup_to_object(floor(), "floor")
     card_obj = soup_to_object(scenes.grid_plane(200.0, 4, z=H, name="card"), "card")

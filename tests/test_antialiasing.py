@@ -48,7 +48,7 @@ def roof() -> TriangleSoup:
     horizon), 0.93 and 0.67: a jump inside the texels along the ridge, no contact."""
     square = [np.array(c, float) for c in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
     tris = []
-    for keep, slope in ((True, SLOPES[0]), (False, SLOPES[1])):
+    for keep in (True, False):
         poly = _clip(square, keep)
         for k in range(1, len(poly) - 1):
             tris.append([poly[0], poly[k], poly[k + 1]])

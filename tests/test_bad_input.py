@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 
 import bpy
-from conftest import ROOT, select_only, small_settings
+from conftest import ROOT, cli_env, run_hao, select_only, small_settings
 
 SPOT = ROOT / "samples" / "spot.obj"
 
@@ -659,10 +659,9 @@ ACCEPTED = [
 
 
 def run_cli(args: list[str], tmp: Path, **kw) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp), "TEMP": str(tmp), "TMP": str(tmp)}
-    env.update(kw.pop("env", {}))
-    return subprocess.run([sys.executable, "-m", "hao_addon", *args], capture_output=True, text=True, env=env,
-                          cwd=kw.pop("cwd", tmp), timeout=300, **kw)
+    """The shared runner (conftest.run_hao) with temporary files in `tmp`, run in `cwd` (default `tmp`)."""
+    extra = {**cli_env(tmp), **kw.pop("env", {})}
+    return run_hao(args, cwd=kw.pop("cwd", tmp), env=extra, timeout=300, **kw)
 
 
 def _case_args(case, inputs: Path, folder: Path) -> tuple[list[str], str, Path, Path]:

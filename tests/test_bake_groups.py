@@ -5,16 +5,14 @@ listed; 'all' lets every group occlude every other."""
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import bpy
-from conftest import select_only, small_settings, soup_to_object
+from conftest import run_hao, select_only, small_settings, soup_to_object
 from hao_addon.core import scenes
 from hao_addon.core.bake.name_groups import match_groups, role_of
 
@@ -80,9 +78,7 @@ def _blend(scene, path: Path, names: set[str]) -> Path:
 
 
 def _hao(*args, tmp: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
-                          env=env, cwd=tmp, timeout=300)
+    done = run_hao(args, cwd=tmp, timeout=300)
     assert done.returncode == 0, done.stderr
     return done
 

@@ -7,20 +7,16 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT, run_hao
 SPOT = ROOT / "samples" / "spot.obj"
 
 
 def run(args, tmp: Path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp)}
-    return subprocess.run([sys.executable, "-m", "hao_addon", "bake", *map(str, args)], capture_output=True,
-                          text=True, env=env, cwd=tmp, timeout=600)
+    return run_hao(["bake", *args], cwd=tmp)
 
 
 @pytest.fixture

@@ -4,14 +4,12 @@ per-frame sync and skips, AO per frame against the ray-traced deformed mesh, the
 methods on the command line, and bad input."""
 from __future__ import annotations
 
-import subprocess
-import sys
 
 import bpy
 import numpy as np
 import pytest
 
-from conftest import DATA, ROOT
+from conftest import DATA, run_hao
 from hao_addon.core.hao import camera_math as cm
 from hao_addon.core.reference import reference_accessibility
 from hao_addon.core.hao.view_settings import ViewAOSettings
@@ -174,12 +172,9 @@ def test_render_ao_methods_on_the_command_line(tmp_path):
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     for method in ("far", "hao+far"):
         out = tmp_path / f"{method}.exr"
-        res = subprocess.run([sys.executable, "-m", "hao_addon", "render-ao", str(blend), "--out", str(out),
-                              "--width", "96", "--height", "72", "--method", method, "--spheres", "32",
-                              "--frame", "12", "--grid", "96", "--rays", "8"],
-                             capture_output=True, text=True, cwd=ROOT, timeout=600)
+        res = run_hao(["render-ao", blend, "--out", out, "--width", "96", "--height", "72", "--method", method,
+                       "--spheres", "32", "--frame", "12", "--grid", "96", "--rays", "8"])
         assert res.returncode == 0, res.stderr
         assert out.exists()
-    res = subprocess.run([sys.executable, "-m", "hao_addon", "render-ao", str(blend), "--out", str(tmp_path / "x.png"),
-                          "--method", "far"], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    res = run_hao(["render-ao", blend, "--out", tmp_path / "x.png", "--method", "far"])
     assert res.returncode == 2 and "needs sphere proxies" in res.stderr

@@ -16,19 +16,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, cli_env, run_hao
 
 SPOT = ROOT / "samples" / "spot.obj"
 BUNNY = ROOT / "bench" / "data" / "stanford-bunny.obj"
 
 
-def env_for(tmp: Path) -> dict:
-    return {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp), "TEMP": str(tmp), "TMP": str(tmp)}
+env_for = cli_env
 
 
 def run(args, tmp: Path, **kw):
-    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
-                          env=env_for(tmp), cwd=tmp, timeout=600, **kw)
+    return run_hao(args, cwd=tmp, **kw)
 
 
 @pytest.fixture
@@ -305,7 +303,7 @@ def test_an_error_after_a_swallowed_signal_is_that_signal(signum, code):
     """A signal inside add-on registration is printed and swallowed by Blender; the glTF
     operator is then missing and the importer call fails. That failure is the signal's echo
     (CI once saw exit 1, 'internal error', for a SIGINT 0.6 s in)."""
-    from hao_addon import cli_errors, cli_io
+    from hao_addon.cli import errors as cli_errors, io as cli_io
 
     cli_io._PENDING[:] = [signum]
     try:

@@ -6,7 +6,6 @@ the ray-traced reference at the vertices, an analytic floor under a ball, and Bl
 through the operator and the CLI."""
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -16,7 +15,7 @@ import pytest
 
 import bpy
 from bake_helpers import assert_within_sample_tolerance
-from conftest import small_settings
+from conftest import run_hao, small_settings
 from hao_addon.bake import bake
 from hao_addon.blender import mesh_data
 from hao_addon.blender.color_attributes import AO_ATTRIBUTE, read_color_attribute
@@ -183,9 +182,7 @@ def test_colour_attributes_refuse_image_only_outputs(gpu_context):
 
 
 def cli(*args, cwd: Path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(cwd)}
-    return subprocess.run([sys.executable, "-m", "hao_addon", "bake", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, env=env, timeout=600)
+    return run_hao(["bake", *args], cwd=cwd)
 
 
 @pytest.mark.parametrize("suffix", [".glb", ".ply", ".blend"])

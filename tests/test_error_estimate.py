@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import functools
 import json
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import shading_scenes as cases
+from conftest import run_hao
 from bake_helpers import texel_points
 from hao_addon.bake import bake
 from hao_addon.core import scenes
@@ -182,10 +181,8 @@ def test_bake_to_a_stated_error_meets_it_and_stops_at_its_cap(gpu_context):
 
 def test_cli_reports_the_error_and_writes_the_error_map(tmp_path):
     out = tmp_path / "ao.png"
-    run = subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(ROOT / "samples" / "spot.obj"), "--size", "128",
-                          "--directions", "64", "--out", str(out), "--error-out", str(tmp_path / "err.exr"),
-                          "--json", str(tmp_path / "r.json")], capture_output=True, text=True, cwd=tmp_path,
-                         env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}, timeout=300)
+    run = run_hao(["bake", ROOT / "samples" / "spot.obj", "--size", "128", "--directions", "64", "--out", out,
+                   "--error-out", tmp_path / "err.exr", "--json", tmp_path / "r.json"], cwd=tmp_path, timeout=300)
     assert run.returncode == 0, run.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     error = report["objects"][0]["error"]
@@ -338,10 +335,9 @@ def test_verify_agrees_with_the_estimate_and_sees_what_it_cannot(gpu_context, me
 
 def test_cli_verify_reports_and_its_bound_fails_the_run_with_the_maps_written(tmp_path):
     out = tmp_path / "ao.png"
-    run = subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(ROOT / "samples" / "spot.obj"), "--size", "64",
-                          "--directions", "32", "--out", str(out), "--verify", "100", "--verify-max-error", "0.005",
-                          "--json", str(tmp_path / "r.json")], capture_output=True, text=True, cwd=tmp_path,
-                         env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}, timeout=300)
+    run = run_hao(["bake", ROOT / "samples" / "spot.obj", "--size", "64", "--directions", "32", "--out", out,
+                   "--verify", "100", "--verify-max-error", "0.005", "--json", tmp_path / "r.json"], cwd=tmp_path,
+                  timeout=300)
     report = json.loads((tmp_path / "r.json").read_text())
     check = report["objects"][0]["verify"]
     assert run.returncode == 1 and report["status"] == "check-failed" and out.is_file(), run.stderr

@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import run_hao
+
 from hao_addon.core.farm.manifest import make_manifest, read_manifest
 from hao_addon.core.frame_ranges import format_frames, parse_frames
 
@@ -30,9 +32,7 @@ BAKE = ["--size", "64", "--directions", "8", "--margin", "2"]
 
 
 def hao(args, cwd: Path, **kw) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(cwd)}
-    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
-                          env=env, cwd=cwd, timeout=600, **kw)
+    return run_hao(args, cwd=cwd, **kw)
 
 
 def openjd(args, cwd: Path) -> subprocess.CompletedProcess:
@@ -161,7 +161,7 @@ def test_every_bake_option_reaches_each_task_unchanged(tmp_path):
                                                     "--chunk={{Task.Param.Chunk}}", "--input-root={{Param.InputRoot}}",
                                                     "--out-dir={{Param.OutputDir}}"]
     forwarded = args[args.index("--progress=openjd") + 2:]  # after the receipt (--json)
-    from hao_addon.cli_parser import build_parser
+    from hao_addon.cli.parser import build_parser
     parse = build_parser().parse_args
     given = vars(parse(["bake", str(SPOT), *options]))
     task = vars(parse(["bake", str(SPOT), *forwarded]))
@@ -526,8 +526,8 @@ def test_the_skip_key_covers_every_setting_from_its_definition():
     default, changes the key: a setting dropped from it (directions, say) fails here."""
     import argparse
 
-    from hao_addon.cli_parser import build_parser
-    from hao_addon.cli_skip import NOT_IN_KEY, run_key
+    from hao_addon.cli.parser import build_parser
+    from hao_addon.cli.skip import NOT_IN_KEY, run_key
     from hao_addon.core.bake.job_options import JobOptions
     from hao_addon.core.bake.settings import BakeSettings
     from hao_addon.core.setting_spec import specs

@@ -7,13 +7,12 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import replace
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 
 import bpy
+from conftest import run_hao
 from hao_addon.bake import clear_cache
 from hao_addon.blender.bake_job import BakeJob, BakeRequest
 from hao_addon.core.bake.settings import BakeSettings
@@ -103,12 +102,10 @@ def test_cancelling_a_sequence_restores_the_frame_and_keeps_the_finished_frames(
 
 
 def test_cli_frames_and_report(tmp_path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp_path)}
     out = tmp_path / "out"
     out.mkdir()
-    done = subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(CESIUM), "--frames", "1-9:4", "--size", "64",
-                           "--directions", "8", "--out", str(out / "walk.{frame}.png"), "--json", str(tmp_path / "r.json")],
-                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+    done = run_hao(["bake", CESIUM, "--frames", "1-9:4", "--size", "64", "--directions", "8",
+                    "--out", out / "walk.{frame}.png", "--json", tmp_path / "r.json"], cwd=tmp_path, timeout=300)
     assert done.returncode == 0, done.stderr
     assert sorted(os.listdir(out)) == ["walk.0001.png", "walk.0005.png", "walk.0009.png"]
     report = json.loads((tmp_path / "r.json").read_text())

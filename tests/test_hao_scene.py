@@ -4,13 +4,11 @@ the render-ao command line and the overlay's registration."""
 from __future__ import annotations
 
 import dataclasses
-import subprocess
-import sys
 
 import bpy
 import numpy as np
 
-from conftest import ROOT
+from conftest import run_hao
 from hao_addon.core.hao import camera_math as cm
 from hao_addon.core import scenes
 from hao_addon.core.hao.view_scene import CLOSED, OPEN, object_from_soup
@@ -153,8 +151,7 @@ def test_scene_objects_are_evaluated_and_cached(addon, gpu_context):
 
 
 def _run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
-                          cwd=ROOT, timeout=600)
+    return run_hao(args)
 
 
 def test_render_ao_command_line(tmp_path):

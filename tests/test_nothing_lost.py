@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import ROOT, select_only, small_settings
+from conftest import ROOT, run_hao, select_only, small_settings
 from hao_addon.bake import clear_cache
 from hao_addon.blender import images, mesh_data
 from hao_addon.blender.bake_job import BakeJob, BakeRequest
@@ -31,9 +31,7 @@ SMALL = BakeSettings(size=64, directions=8, margin=2)
 
 
 def run(args, tmp: Path, **kw) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp)}
-    return subprocess.run([sys.executable, "-m", "hao_addon", *map(str, args)], capture_output=True, text=True,
-                          env=env, cwd=tmp, timeout=600, **kw)
+    return run_hao(args, cwd=tmp, **kw)
 
 
 def leftovers(folder: Path) -> list[str]:

@@ -142,8 +142,30 @@ def test_overlapping_written_uvs_fail_the_bake_and_leave_no_uv_map(scene, monkey
 def test_named_uv_map_missing_is_a_clear_error(scene):
     monkey()
     small_settings(scene, uv_mode='NAMED', uv_map="Nope")
-    with pytest.raises(RuntimeError, match="no UV map named 'Nope'"):
+    with pytest.raises(RuntimeError, match="no UV map named 'Nope'") as raised:
         bpy.ops.object.hao_bake_ao()
+    assert "internal error" not in str(raised.value)  # the user's mistake, said as such
+
+
+def test_a_bug_is_reported_as_an_internal_error_and_changes_nothing(scene, monkeypatch, addon):
+    """Only the project's own error types are the user's (operators/bake_operator.USER_ERRORS):
+    a KeyError inside the bake is a bug, reported as an internal error that says where its
+    traceback went, not as bad input; the scene is as it was."""
+    import sys
+    bake_job = sys.modules[f"{addon.__name__}.hao_addon.blender.bake_job"]  # the operator's copy
+
+    def broken(self):
+        raise KeyError("a bug")
+
+    monkeypatch.setattr(bake_job.BakeJob, "run", broken)
+    obj = monkey()
+    before, images = uv_array(obj.data, "UVMap"), set(bpy.data.images.keys())
+    small_settings(scene)
+    with pytest.raises(RuntimeError, match=r"internal error \(KeyError: 'a bug'\); the traceback is in the system "
+                                           r"console"):
+        bpy.ops.object.hao_bake_ao()
+    assert set(bpy.data.images.keys()) == images and [l.name for l in obj.data.uv_layers] == ["UVMap"]
+    np.testing.assert_array_equal(uv_array(obj.data, "UVMap"), before)
 
 
 def test_existing_image_is_overwritten_and_material_wired(scene):

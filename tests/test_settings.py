@@ -12,7 +12,7 @@ import pytest
 
 import bpy
 from conftest import ROOT
-from hao_addon.cli_parser import build_parser
+from hao_addon.cli.parser import build_parser
 from hao_addon.core.setting_spec import SettingError, check_value, specs
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings
@@ -46,7 +46,7 @@ def test_cli_options_match_the_core(cls, command, group):
 
 @pytest.mark.parametrize("cls, command, group", [s for s in SETTINGS if s[2]], ids=["bake", "view"])
 def test_panel_properties_match_the_core(addon, cls, command, group):
-    rna = getattr(bpy.types.Scene.bl_rna.properties[group], "fixed_type").bl_rna.properties
+    rna = bpy.types.Scene.bl_rna.properties[group].fixed_type.bl_rna.properties
     for f, spec in specs(cls):
         if not spec.ui:
             continue

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import select_only, small_settings, soup_to_object
+from conftest import run_hao, select_only, small_settings, soup_to_object
 from hao_addon.bake import bake
 from hao_addon.blender import mesh_data
 from hao_addon.core import scenes
@@ -87,21 +87,15 @@ def test_cli_texture_set_and_several_objects(tmp_path):
     report; without it, one file per object ({object})."""
     import json
     import os
-    import subprocess
-    import sys
-    from pathlib import Path
     from test_cli_runs import write_obj
-    root = Path(__file__).resolve().parent.parent
     source = tmp_path / "set.obj"
     write_obj(source, {p.name: p for p in parts()})
-    env = {**os.environ, "PYTHONPATH": str(root), "TMPDIR": str(tmp_path)}
     out = tmp_path / "out"
     out.mkdir()
 
     def run(*extra):
-        return subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(source), "--size", "64", "--directions",
-                               "16", "--object", "ball", "--object", "floor", "--json", tmp_path / "r.json",
-                               *map(str, extra)], capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        return run_hao(["bake", source, "--size", "64", "--directions", "16", "--object", "ball", "--object", "floor",
+                        "--json", tmp_path / "r.json", *extra], cwd=tmp_path, timeout=300)
     done = run("--texture-set", "--out", out / "{object}.png")
     assert done.returncode == 0, done.stderr
     report = json.loads((tmp_path / "r.json").read_text())

@@ -12,11 +12,9 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
-import truth as truth_module  # noqa: E402
 from truth import texel_truth  # noqa: E402
 
 from hao_addon.core import scenes  # noqa: E402
-from hao_addon.core.bake.terminator import MIN_LIFT  # noqa: E402
 from hao_addon.core.objfile import obj_soup  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import run_hao
+
 from bake_helpers import error_stats
 from hao_addon.bake import bake
 from hao_addon.core import scenes
@@ -150,19 +152,13 @@ def test_cli_writes_one_file_per_tile_and_refuses_gltf(tmp_path):
     no file."""
     import json
     import os
-    import subprocess
-    import sys
     from pathlib import Path
     from test_cli_runs import write_obj
-    root = Path(__file__).resolve().parent.parent
     source = tmp_path / "udim.obj"
     write_obj(source, {"udim": combined(islands(), TILES)})
-    env = {**os.environ, "PYTHONPATH": str(root), "TMPDIR": str(tmp_path)}
 
     def run(*extra):
-        return subprocess.run([sys.executable, "-m", "hao_addon", "bake", str(source), "--size", "64", "--directions",
-                               "16", *map(str, extra)], capture_output=True, text=True, env=env, cwd=tmp_path,
-                              timeout=300)
+        return run_hao(["bake", source, "--size", "64", "--directions", "16", *extra], cwd=tmp_path, timeout=300)
     done = run("--out", tmp_path / "ao.<UDIM>.exr", "--json", tmp_path / "r.json")
     assert done.returncode == 0, done.stderr
     files = [str(tmp_path / f"ao.{tile}.exr") for tile in TILES]

@@ -19,6 +19,7 @@ from hao_addon.bake import bake
 from hao_addon.core import scenes
 from hao_addon.core.bake import error_estimate as ee
 from hao_addon.core.bake.settings import QUALITY_CAPS, BakeSettings
+from hao_addon.core.geometry import TriangleSoup
 from hao_addon.core.objfile import obj_soup
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -304,10 +305,9 @@ def test_presets_cap_themselves_and_a_capped_bake_says_what_it_needs(gpu_context
     assert any("needs about" in w and "raise Directions" in w for w in capped.stats["warnings"])
 
 
-def crease_soup(size: int) -> "TriangleSoup":
+def crease_soup(size: int) -> TriangleSoup:
     """A floor (z = 0, x in [0, 1]) meeting a wall (x = 0, facing +x) at a concave right angle,
     their UV charts sharing the crease on a column of texel centres (u = 8.5 / 16 at 16^2)."""
-    from hao_addon.core.geometry import TriangleSoup
     c = (size // 2 + 0.5) / size
     floor = [[(0, 0, 0), (1, 0, 0), (1, 1, 0)], [(0, 0, 0), (1, 1, 0), (0, 1, 0)]]
     wall = [[(0, 0, 0), (0, 1, 0), (0, 1, 1)], [(0, 0, 0), (0, 1, 1), (0, 0, 1)]]

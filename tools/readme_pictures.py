@@ -30,7 +30,7 @@ from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.geometry import TriangleSoup  # noqa: E402
 from hao_addon.core.imageio import write_ao_file  # noqa: E402
 from hao_addon.core.objfile import read_obj  # noqa: E402
-from hao_addon.blender.gpu_context import ensure_gpu_context  # noqa: E402
+from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
 

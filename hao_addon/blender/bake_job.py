@@ -743,7 +743,7 @@ class BakeJob:
         req = self.request
         files = self.files
         stored, extra = {}, {}
-        for obj, label, result in self.baked():
+        for _obj, label, result in self.baked():
             name = req.image_name or f"{label}_AO"
             # Re-baking updates the object's AO image in place (materials keep pointing at it).
             existing = req.image or bpy.data.images.get(name)

@@ -11,6 +11,7 @@ import numpy as np
 from .. import compat
 from ..core.bake.alpha import SoupAlpha
 from ..core.errors import BakeInputError
+from .mesh_arrays import loop_uvs
 
 
 def principled_bsdf(material) -> "bpy.types.Node | None":
@@ -112,7 +113,6 @@ def soup_alpha(obj: bpy.types.Object, mesh: bpy.types.Mesh, tri_loops: np.ndarra
     """The alpha of an evaluated mesh's triangles (tri_loops (F, 3), evaluated_soup's corner
     order), or None when every face is opaque and nothing was read as opaque for want of
     a better reading (else its notes say what)."""
-    from .mesh_data import loop_uvs
 
     materials = [slot.material for slot in obj.material_slots] or [None]
     found = [material_alpha(m) for m in materials]

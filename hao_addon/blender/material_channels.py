@@ -11,6 +11,7 @@ import numpy as np
 from ..core.bake.orm import channel_map, sample_nearest
 from ..core.errors import BakeInputError
 from .material_alpha import principled_bsdf, texture_uv_map
+from .mesh_arrays import loop_uvs, mesh_arrays
 
 CHANNELS = {"Red": 0, "Green": 1, "Blue": 2, "R": 0, "G": 1, "B": 2}
 
@@ -45,12 +46,11 @@ def _pixels(image) -> np.ndarray:
 def roughness_metallic(obj, depsgraph, uvs: np.ndarray, size: int, margin: int) -> tuple[np.ndarray, np.ndarray]:
     """((size, size) roughness, (size, size) metallic) of the object's evaluated mesh in the
     layout uvs (F, 3, 2: its triangles in evaluated_soup's order on the baked UV map)."""
-    from .mesh_data import _mesh_arrays, loop_uvs
 
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
-        _co, _tri_verts, tri_loops = _mesh_arrays(mesh)
+        _co, _tri_verts, tri_loops = mesh_arrays(mesh)
         if np.linalg.det(np.array(obj_eval.matrix_world)[:3, :3]) < 0.0:
             tri_loops = tri_loops[:, ::-1]
         polygon = np.empty(len(mesh.loop_triangles), np.int64)

@@ -12,7 +12,7 @@ import bpy
 import numpy as np
 
 from ..core.proxies.lloyd import ProxyError, check_radii, lloyd_clusters, sphere_proxies, vertex_areas
-from .mesh_data import read_positions
+from .mesh_arrays import read_positions
 
 CLUSTER_ATTRIBUTE = "hao_sphere_cluster"
 WEIGHT_ATTRIBUTE = "hao_sphere_weight"

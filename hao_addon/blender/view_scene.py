@@ -17,7 +17,7 @@ import mathutils
 import numpy as np
 
 from ..core.hao.view_scene import OPEN, SceneObject, fill_class
-from .mesh_data import read_positions
+from .mesh_arrays import read_positions
 
 BAKED_AO_PROPERTY = "hao_ao_image"  # set on objects by the Bake AO operator
 

@@ -5,7 +5,6 @@ object cache behind them; the sphere proxies. operators/viewport_overlay.py hold
 session and calls draw() from its draw handler."""
 from __future__ import annotations
 
-import bpy
 import numpy as np
 
 from ..core.hao.methods import method_plan

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .components import root_labels
+
 
 @dataclass
 class TriangleSoup:
@@ -242,7 +244,6 @@ def surface_holes(positions: np.ndarray, welded: tuple[np.ndarray, np.ndarray] |
 def component_labels(tri: np.ndarray, vertex_count: int) -> np.ndarray:
     """(V,) int64 label of each vertex's connected part (the smallest vertex number in it)
     for (F, 3) int vertex triangles."""
-    from .bake.charts import root_labels
     tri = np.asarray(tri)
     return root_labels(vertex_count, np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]]]))
 

@@ -247,7 +247,7 @@ def _umask() -> int:
 
 
 # The text entry a bake's files carry: a digest of what made them (the input files, the
-# settings, the version; cli_farm.py), so that --skip-existing can tell a finished output
+# settings, the version; cli/farm.py), so that --skip-existing can tell a finished output
 # from one of other settings. PNG: a tEXt chunk; EXR: a string attribute.
 BAKE_KEY = "hao_bake_key"
 # An EXR's digest of its scanline blocks (blake2b, hex), a string attribute.

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """One definition per setting: a dataclass field carries its default and a ``Spec`` (label,
 description, range, unit, choices). The Blender properties (``operators/setting_props.py``),
-the command-line options (``hao_addon/cli_options.py``) and the manual's settings page
+the command-line options (``hao_addon/cli/options.py``) and the manual's settings page
 (``tools/docs_pages.py``) are generated from it, and ``validate`` is the only range check.
 """
 from __future__ import annotations

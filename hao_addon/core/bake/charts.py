@@ -21,13 +21,19 @@ corners a polygon's triangles share get one UV. Blender stores UVs per polygon c
 quad split across two charts would write one of them over the other (Suzanne without UVs
 overlapped on half its texels that way).
 
-This file imports only numpy: the unwrap's child process loads it by file name.
+This file imports only numpy and ``core/components.py``: the unwrap's child process loads
+it by file name.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+try:
+    from ..components import connected_components
+except ImportError:  # the unwrap's child process: unwrap_worker.py puts core/ on sys.path
+    from components import connected_components
 
 # Smart UV Project's default angle limit: a face joins the direction within this angle.
 ANGLE_LIMIT_DEG = 66.0
@@ -112,32 +118,6 @@ def adjacent_faces(triangles: np.ndarray) -> np.ndarray:
     same = key[1:] == key[:-1]
     pairs = np.stack([faces[:-1][same], faces[1:][same]], axis=1)
     return pairs[pairs[:, 0] != pairs[:, 1]]
-
-
-def connected_components(count: int, pairs: np.ndarray) -> np.ndarray:
-    """(count,) component index 0..C-1 of each node of an undirected graph with edges
-    pairs (P, 2)."""
-    return np.unique(root_labels(count, pairs), return_inverse=True)[1].reshape(-1)
-
-
-def root_labels(count: int, pairs: np.ndarray) -> np.ndarray:
-    """(count,) the smallest node of each node's component, for edges pairs (P, 2): hooking
-    of roots plus pointer jumping, a few array passes even on long chains (6 for the
-    35k-vertex bunny's triangles)."""
-    label = np.arange(count)
-    while True:
-        low = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
-        before = label.copy()
-        # Hook each root to the lowest root it touches, then jump every node to its root.
-        np.minimum.at(label, label[pairs[:, 0]], low)
-        np.minimum.at(label, label[pairs[:, 1]], low)
-        while True:
-            jumped = label[label]
-            if np.array_equal(jumped, label):
-                break
-            label = jumped
-        if np.array_equal(label, before):
-            return label
 
 
 def islands_of(face_direction: np.ndarray, pairs: np.ndarray) -> np.ndarray:

@@ -3,7 +3,7 @@
 
 Charts come from planar projections (``charts.py``, numpy); xatlas packs them. xatlas holds
 the interpreter lock while it runs, so ``core/bake/unwrap.py`` runs this in a child that can
-be killed at once. This file imports only numpy, xatlas and its sibling ``charts.py`` (by
+be killed at once. This file imports only numpy, xatlas, its sibling ``charts.py`` and ``core/components.py`` (by
 file name in the child): the child must not need the add-on's package to be importable.
 """
 from __future__ import annotations
@@ -14,7 +14,9 @@ import numpy as np
 
 try:
     from .charts import Charts, overlapping_faces, projection_charts, split_islands
-except ImportError:  # the child process: run as a script beside charts.py
+except ImportError:  # the child process: run as a script beside charts.py, below components.py
+    from pathlib import Path
+    sys.path.insert(1, str(Path(__file__).resolve().parent.parent))
     from charts import Charts, overlapping_faces, projection_charts, split_islands
 
 # The packed atlas is checked for overlaps at the texel centres of the texture it is packed

@@ -76,7 +76,7 @@ def lloyd_clusters(vertices: np.ndarray, weights: np.ndarray, k: int, seed: int 
     energies = []
     converged = False
     labels = None
-    for it in range(max_iterations):
+    for it in range(max_iterations):  # noqa: B007 - the count it reached is returned
         labels, d2 = _assign(points, centres)
         energies.append(float((w * d2).sum()))
         mass = np.bincount(labels, weights=w, minlength=k)

@@ -5,9 +5,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .cli_errors import CLIError, last_line
-from .cli_io import check_signals
-from .cli_parser import INPUT_FORMATS
+from .errors import CLIError, last_line
+from .io import check_signals
+from .parser import INPUT_FORMATS
 
 
 def check_input(path: Path, allowed: tuple[str, ...]) -> Path:
@@ -27,7 +27,7 @@ def check_input(path: Path, allowed: tuple[str, ...]) -> Path:
 def check_json_target(spec: str | None) -> None:
     if spec in (None, "-"):
         return
-    from .core.folders import nearest_existing, unmakeable_reason
+    from ..core.folders import nearest_existing, unmakeable_reason
 
     folder = Path(os.path.abspath(spec)).parent
     reason = unmakeable_reason(folder)
@@ -132,7 +132,7 @@ def check_mesh_target(path: str, source: Path, allowed: tuple[str, ...], option:
     out = Path(os.path.abspath(path))
     if out.suffix.lower() not in allowed:
         raise CLIError(f"{option} must be a {' or '.join(allowed)} file (one file, written atomically), got '{path}'")
-    from .core.folders import nearest_existing, unmakeable_reason
+    from ..core.folders import nearest_existing, unmakeable_reason
 
     reason = unmakeable_reason(out.parent)
     if reason or not os.access(nearest_existing(out.parent), os.W_OK):
@@ -153,7 +153,7 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
     session as a .blend copy; atomically (a temporary file in the same folder, renamed over
     path)."""
     import bpy
-    from .core.folders import make_folders, remove_made
+    from ..core.folders import make_folders, remove_made
 
     for other in bpy.context.view_layer.objects:
         other.select_set(other in objects)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import os
 import traceback
 
-from .cli_io import EXIT_INTERRUPTED, pending_signal, ProcessOutput, Terminated
-from .core.errors import UserInputError
+from .io import EXIT_INTERRUPTED, pending_signal, ProcessOutput, Terminated
+from ..core.errors import UserInputError
 
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
@@ -41,7 +41,7 @@ def failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
     if isinstance(exc, CLIError):
         return exc.code, str(exc)
     try:
-        from .blender.gpu_context import GPUUnavailableError
+        from ..gpu.context import GPUUnavailableError
     except ImportError:  # no bpy at all
         GPUUnavailableError = ()  # noqa: N806
     if GPUUnavailableError and isinstance(exc, GPUUnavailableError):

@@ -12,95 +12,19 @@ import argparse
 import json
 import os
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
-from . import __version__
-from .cli_io import Report
-from .core.farm import flamenco, openjd, opencue
-from .core.farm.manifest import Manifest, make_manifest, read_manifest
-from .core.farm.tasks import RUNNERS
-from .core.imageio import atomic_write_bytes
-
-
-@dataclass(frozen=True)
-class Job:
-    """What a job's files are made of (every format takes the same)."""
-
-    manifest: Manifest
-    runner: str
-    options: list  # the bake options, forwarded
-    values: dict  # the job's paths and executable: keys as openjd.PARAM's
-    name: str
-    extra_inputs: list  # --high-poly files, uploaded with the inputs
-
-
-def _openjd_files(job: Job) -> dict[str, str]:
-    params = {k: job.values[k] for k in openjd.PARAM if k in job.values}
-    return {"template.json": _json(openjd.job_template(job.manifest, job.runner, job.options, job.name, __version__)),
-            "parameter_values.json": _json(openjd.parameter_values(params)),
-            "job_parameters.json": _json(openjd.job_parameters(params)),
-            "asset_references.json": _json(openjd.asset_references(job.manifest, job.values["manifest"],
-                                                                   job.values["out_dir"], job.extra_inputs))}
-
-
-def _flamenco_files(job: Job) -> dict[str, str]:
-    return {flamenco.SCRIPT_NAME: flamenco.job_type_script(job.manifest, job.runner, job.options, job.name,
-                                                           __version__),
-            "job.json": _json(flamenco.job_settings(job.values, job.name))}
-
-
-def _opencue_files(job: Job) -> dict[str, str]:
-    return {opencue.COMMANDS_NAME: opencue.command_file(job.manifest, job.runner, job.options, job.values)}
-
-
-def _json(data) -> str:
-    return json.dumps(data, indent=2) + "\n"
-
-
-# The formats `farm` writes: (help, the job's files {name: text} besides manifest.json).
-FORMATS = {
-    "openjd": ("an Open Job Description job bundle (AWS Deadline Cloud; 'openjd run' runs it locally)", _openjd_files),
-    "flamenco": ("a Flamenco job type (JavaScript) and the job's settings", _flamenco_files),
-    "opencue": ("an OpenCue command file for cuecmd, one line per task", _opencue_files),
-}
-# farm's own options (and the outputs the manifest carries): not forwarded to the tasks.
-FARM_OWN = frozenset({"command", "farm_command", "input", "out", "out_dir", "frames", "skip_existing", "json",
-                      "quiet", "bundle", "chunk_size", "runner", "executable", "addon_path", "name", "help"})
-DEFAULT_CHUNK = 10
-# The folder holding hao_addon: a python runner's PYTHONPATH.
-ADDON_FOLDER = str(Path(__file__).resolve().parent.parent)
-
-
-def add_farm_parsers(sub, add_bake_arguments, add_run_options) -> None:
-    farm = sub.add_parser("farm", help="write a bake job for a render farm (OpenJD, Flamenco, OpenCue)")
-    kinds = farm.add_subparsers(dest="farm_command", required=True)
-    for name, (text, _writer) in FORMATS.items():
-        p = kinds.add_parser(name, help=f"write {text}")
-        add_bake_arguments(p)
-        p.add_argument("--bundle", required=True, metavar="DIR", help="the folder to write the job into")
-        p.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK, metavar="N",
-                       help=f"inputs (or frames of --frames) per task (default {DEFAULT_CHUNK})")
-        p.add_argument("--runner", choices=tuple(RUNNERS), default="blender",
-                       help="how a worker runs hao: blender (a Blender with the extension: blender -b -c hao "
-                            "bake ...; default) or python (a Python with the bpy wheel: PATH -m hao_addon bake ...)")
-        p.add_argument("--executable", default=None, metavar="PATH",
-                       help="the runner's executable on the workers (a job parameter; default: 'blender', or this "
-                            "Python for --runner python)")
-        p.add_argument("--addon-path", default=ADDON_FOLDER, metavar="DIR",
-                       help="--runner python: the folder holding hao_addon on the workers (default: this one)")
-        p.add_argument("--name", default="HAO AO bake", help="the job's name")
-        add_run_options(p)
-    v = kinds.add_parser("verify", help="a job's last step: fail, naming them, if expected outputs are missing")
-    v.add_argument("--manifest", required=True, metavar="FILE")
-    v.add_argument("--out-dir", required=True, metavar="DIR")
-    add_run_options(v)
+from .. import __version__
+from .farm_formats import FARM_OWN, FORMATS, Job
+from .io import Report
+from ..core.farm.manifest import Manifest, make_manifest, read_manifest
+from ..core.imageio import atomic_write_bytes
 
 
 def forwarded_options(args: argparse.Namespace) -> list[str]:
     """The bake options given (those not at their defaults, and not farm's own), as
     '--option=value' (a value may start with '-'), flags alone, repeatable ones repeated."""
-    from .cli_parser import add_bake_arguments
+    from .parser import add_bake_arguments
 
     bake = argparse.ArgumentParser(add_help=False)
     add_bake_arguments(bake)
@@ -129,9 +53,9 @@ def _absolute_if_file(value: str) -> str:
 def run_farm(args, report: Report, progress) -> list[str]:
     if args.farm_command == "verify":
         return run_verify(args, report)
-    from .cli_errors import CLIError
-    from .cli_parser import BATCH_NAME, INPUT_FORMATS
-    from .cli_scene import check_input
+    from .errors import CLIError
+    from .parser import BATCH_NAME, INPUT_FORMATS
+    from .scene import check_input
     if not args.input:
         raise CLIError(f"farm {args.farm_command} needs the INPUT files of the job")
     if not args.out_dir:
@@ -140,7 +64,7 @@ def run_farm(args, report: Report, progress) -> list[str]:
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
     _check_farm_outputs(args)
-    from .cli_bake import checked_options
+    from .bake import checked_options
     checked_options(_with_out(args, template))  # every bake option, as a task would check it
     for path in args.input:
         check_input(Path(path), INPUT_FORMATS)
@@ -180,8 +104,8 @@ def _check_farm_outputs(args) -> None:
     """Every file a task writes lands in --out-dir: the extra outputs are names (or relative
     paths) in it, never absolute and never above it (a task's own folder is the farm's
     scratch space, deleted after the task)."""
-    from .cli_errors import CLIError
-    from .cli_parser import EXTRA_OUTPUT_OPTIONS
+    from .errors import CLIError
+    from .parser import EXTRA_OUTPUT_OPTIONS
     for option in EXTRA_OUTPUT_OPTIONS:
         value = getattr(args, option, "") or ""
         if value and (os.path.isabs(value) or ".." in Path(value).parts):
@@ -193,8 +117,8 @@ def _check_farm_outputs(args) -> None:
 def job_outputs(args, template: str) -> tuple[str, ...]:
     """The file names (templates, '{input}' unfilled) a task writes per input in the
     output folder: --out, then each map of --maps and each extra output option."""
-    from .cli_bake import fill_map_outputs
-    from .cli_parser import EXTRA_OUTPUT_OPTIONS
+    from .bake import fill_map_outputs
+    from .parser import EXTRA_OUTPUT_OPTIONS
     names = argparse.Namespace(**vars(args))
     names.out = template
     fill_map_outputs(names)
@@ -205,7 +129,7 @@ def _check_collisions(args, template: str) -> None:
     """The batch's own check over the whole job, before anything is written: two inputs
     whose files would land on one name (same file name in two folders, names that clean
     to one, an --out without {input}) are refused here, not found overwritten on the farm."""
-    from .cli_batch import batch_plan
+    from .batch import batch_plan
     batch_plan(args, Path(os.path.abspath(args.out_dir)), template)
 
 
@@ -213,8 +137,8 @@ def _check_job_text(farm: str, manifest: Manifest, options: list[str], values: d
     """What a farm parses: no control character anywhere (a newline splits a cuecmd line
     into two commands), and no '{{' or '}}' in what an OpenJD template holds (its format
     strings' own delimiters; paths travel as parameter values, never parsed)."""
-    from .cli_errors import CLIError
-    from .core.farm.manifest import text_fault
+    from .errors import CLIError
+    from ..core.farm.manifest import text_fault
     texts = [("an input path", manifest.root + "/" + entry) for entry in manifest.entries]
     texts += [("--out", manifest.out), ("--name", name)] + [("a bake option", option) for option in options]
     names = {"input_root": "the input folder", "out_dir": "--out-dir", "manifest": "--bundle",
@@ -235,7 +159,7 @@ def take_manifest_chunk(args) -> None:
     """A farm task's bake: its chunk's inputs (under --input-root, else the manifest's
     root), the manifest's output name, the chunk's frames; --out-dir is required (made
     when a file is written)."""
-    from .cli_errors import CLIError
+    from .errors import CLIError
     if args.input:
         raise CLIError("--manifest names the inputs: give no INPUT besides it")
     if not args.out_dir:
@@ -255,7 +179,7 @@ def take_manifest_chunk(args) -> None:
 
 
 def check_chunk_without_manifest(args) -> None:
-    from .cli_errors import CLIError
+    from .errors import CLIError
     if args.chunk is not None or args.input_root:
         raise CLIError("--chunk and --input-root belong to a farm task's --manifest: give --manifest FILE")
 
@@ -264,9 +188,9 @@ def expected_outputs(manifest: Manifest, entry: str) -> list[tuple[int | None, s
     """(frame or None, file name in the output folder) of every file the Bake step writes
     for one input: each of manifest.outputs, '{input}' filled, per frame; '{object}' and
     UDIM tiles stay as tokens (the task's receipt names those files)."""
-    from .core.output_files import input_file_name
-    from .core.frame_ranges import parse_frames
-    from .core.output_files import FRAME_TOKEN, INPUT_TOKEN, frame_file, with_token
+    from ..core.output_files import input_file_name
+    from ..core.frame_ranges import parse_frames
+    from ..core.output_files import FRAME_TOKEN, INPUT_TOKEN, frame_file, with_token
     frames = parse_frames(manifest.frames) if manifest.frames else [None]
     out = []
     for template in manifest.outputs:
@@ -283,8 +207,8 @@ def _name_pattern(name: str):
     an input held several meshes (as the bake names them)."""
     import re
 
-    from .core.bake.udim import UDIM_TOKEN
-    from .core.output_files import OBJECT_TOKEN
+    from ..core.bake.udim import UDIM_TOKEN
+    from ..core.output_files import OBJECT_TOKEN
     stem, ext = os.path.splitext(name)
     parts = re.escape(stem).replace(re.escape(OBJECT_TOKEN), ".+").replace(re.escape(UDIM_TOKEN), r"\d{4}")
     several = "" if OBJECT_TOKEN in stem else "(_.+)?"
@@ -295,8 +219,8 @@ def _owners(names: list[str], recorded: list[str]) -> dict[str, list[str]]:
     """{expected name: the recorded files it stands for}: each file goes to the one name
     whose pattern matches it with the most literal characters ('b_{object}_thickness.png'
     over 'b_{object}.png' for 'b_b_thickness.png')."""
-    from .core.bake.udim import UDIM_TOKEN
-    from .core.output_files import OBJECT_TOKEN
+    from ..core.bake.udim import UDIM_TOKEN
+    from ..core.output_files import OBJECT_TOKEN
     patterns = [(len(n.replace(OBJECT_TOKEN, "").replace(UDIM_TOKEN, "")), n, _name_pattern(n)) for n in names]
     owned: dict[str, list[str]] = {}
     for file in recorded:
@@ -328,8 +252,8 @@ def run_verify(args, report: Report) -> list[str]:
     every input (each map of the job, each frame), by its exact name where the manifest
     gives it, else (an '{object}' name, UDIM tiles) as the input's own task recorded it;
     every file must decode in full."""
-    from .cli_errors import EXIT_FAILURE, CLIError
-    from .core.file_checks import output_is_whole
+    from .errors import EXIT_FAILURE, CLIError
+    from ..core.file_checks import output_is_whole
     manifest = read_manifest(args.manifest)
     out_dir = os.path.abspath(args.out_dir)
     written = receipts(manifest, out_dir)

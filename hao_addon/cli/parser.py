@@ -1,16 +1,16 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The command line's parser: every command and option (the bake settings' options come from
-their one definition, cli_options.py)."""
+their one definition, options.py)."""
 from __future__ import annotations
 
 import argparse
 import re
 import sys
 
-from . import __version__
-from .cli_errors import CLIError
-from .cli_io import ProcessOutput
-from .cli_options import add_setting_options
+from .. import __version__
+from .errors import CLIError
+from .io import ProcessOutput
+from .options import add_setting_options
 
 
 # A batch's file names in --out-dir, unless --out gives them ({input}: the input's name without
@@ -27,7 +27,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .core.hao.view_settings import RenderSize, ViewAOSettings
+    from ..core.hao.view_settings import RenderSize, ViewAOSettings
 
     parser = _Parser(prog="hao", description="GPU ambient occlusion for Blender scenes and meshes.")
     parser.add_argument("--version", action="version", version=f"hao {__version__}")
@@ -44,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(Open Job Description's form, for farm tasks)")
     add_run_options(b)
 
-    from .cli_farm import add_farm_parsers
+    from .farm_formats import add_farm_parsers
     add_farm_parsers(sub, add_bake_arguments, add_run_options)
 
     r = sub.add_parser("render-ao", help="render viewport AO (HAO) from a scene camera into an image file")
@@ -73,8 +73,8 @@ EXTRA_OUTPUT_OPTIONS = (*IMAGE_OPTIONS, "gltf_out")
 def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     """What a bake takes (bake, and the farm commands that write bake jobs): inputs, outputs,
     frames and every bake setting."""
-    from .core.bake.job_options import JobOptions
-    from .core.bake.settings import BakeSettings
+    from ..core.bake.job_options import JobOptions
+    from ..core.bake.settings import BakeSettings
 
     b.add_argument("input", nargs="*", help=".obj, .glb/.gltf or .blend file; several make a batch (--out-dir)")
     b.add_argument("--out", default=None,

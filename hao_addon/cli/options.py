@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .core.setting_spec import Spec, specs
+from ..core.setting_spec import Spec, specs
 
 
 def cli_default(field, spec: Spec):

@@ -12,7 +12,7 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
-from . import __version__
+from .. import __version__
 
 # Options that name files or steer the run, not what the pixels are: a farm task and a
 # local run of the same bake (other paths, a chunk of the frames) share the key, so their
@@ -55,8 +55,8 @@ def skip_finished(request, key: str, report) -> tuple[object | None, list[str]]:
     skipped). The skipped
     files are listed in report.outputs and report.skipped; a sequence's skipped frames in
     report.frames (with skipped: true)."""
-    from .blender.bake_job import finished_files
-    from .cli_io import REPORT
+    from ..blender.bake_job import finished_files
+    from .io import REPORT
     # The report is written by every run, finished or not: not a file the bake must find.
     wanted = replace(request, extra_outputs=[entry for entry in request.extra_outputs if entry[1] != REPORT])
     if not request.frames:

@@ -7,15 +7,15 @@ import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
-from .cli_errors import CLIError
-from .cli_io import check_signals, deferred_signals, Progress, REPORT, Report
-from .cli_options import option_for, settings_from_args
-from .cli_parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
-from .cli_scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
+from .errors import CLIError
+from .io import check_signals, deferred_signals, Progress, REPORT, Report
+from .options import option_for, settings_from_args
+from .parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
+from .scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
                         export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
-from .core.frame_ranges import parse_frames
-from .core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
-from .core.setting_spec import SettingError
+from ..core.frame_ranges import parse_frames
+from ..core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
+from ..core.setting_spec import SettingError
 
 
 GLTF_OUT = "the glTF file (--gltf-out)"  # its name in collision messages
@@ -33,7 +33,7 @@ class _Run:
     mesh_out: Path | None  # a colour bake's mesh file
     reads: list[tuple[str, str]]
     writes: list[tuple[str, str]]
-    key: str  # the run's bake key (cli_skip.run_key), once the scene is loaded (_scene_key)
+    key: str  # the run's bake key (skip.run_key), once the scene is loaded (_scene_key)
 
     @property
     def to_colors(self) -> bool:
@@ -45,7 +45,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     or nothing; returns the summary lines to print."""
     import bpy
 
-    from .blender.bake_job import BakeJob
+    from ..blender.bake_job import BakeJob
 
     run = _checked_run(args, report)
     with report.phase("load"):
@@ -62,7 +62,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)  # validates; refuses unwritable outputs
     skip_lines = []
     if args.skip_existing:  # checked after the validation: a run that would be refused is, finished or not
-        from .cli_skip import skip_finished
+        from .skip import skip_finished
         left, skip_lines = skip_finished(request, run.key, report)
         if left is None:
             return skip_lines
@@ -77,8 +77,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 
 def _checked_run(args, report: Report) -> _Run:
     """The settings, and every file the run reads and writes, checked before a long load."""
-    from .blender.paths import example_path
-    from .core.imageio import check_writable
+    from ..blender.paths import example_path
+    from ..core.imageio import check_writable
 
     settings, options, frames = checked_options(args)
     source = check_input(Path(args.input), INPUT_FORMATS)
@@ -120,8 +120,8 @@ def checked_options(args) -> tuple[object, object, list[int] | None]:
     """(BakeSettings, JobOptions, frames) of the options, each checked as a bake checks them
     before it loads anything; a farm job's writer runs the same checks (nothing is refused
     later, on the farm, that could have been refused at submission)."""
-    from .core.bake.job_options import JobOptions
-    from .core.bake.settings import BakeSettings
+    from ..core.bake.job_options import JobOptions
+    from ..core.bake.settings import BakeSettings
     fill_map_outputs(args)
     settings = validated(settings_from_args(args, BakeSettings), BakeSettings)
     options = validated(settings_from_args(args, JobOptions), JobOptions)
@@ -146,8 +146,8 @@ def _check_image_options(args, options, frames) -> None:
 def _scene_key(args, run: _Run) -> str:
     """The run's bake key once the scene is loaded: its texture files count as inputs (an
     alpha texture edited on disk makes the maps stale)."""
-    from .blender.images import scene_image_files
-    from .cli_skip import run_key
+    from ..blender.images import scene_image_files
+    from .skip import run_key
     files = [Path(path) for path, _what in run.reads]
     files += [Path(path) for path, _what in scene_image_files() if os.path.isfile(path)]
     return run_key(args, files)
@@ -156,7 +156,7 @@ def _scene_key(args, run: _Run) -> str:
 def fill_map_outputs(args) -> None:
     """--maps: each map without its own output option is written beside --out, named after
     it with _MAP before the extension."""
-    from .cli_parser import MAP_OUTPUTS
+    from .parser import MAP_OUTPUTS
 
     names = [name.strip() for name in (getattr(args, "maps", "") or "").split(",") if name.strip()]
     unknown = [name for name in names if name not in MAP_OUTPUTS]
@@ -202,7 +202,7 @@ def _pick_groups(args, run: _Run, report: Report) -> list:
     names that matched nothing become warnings."""
     import bpy
 
-    from .blender.bake_groups import bake_groups
+    from ..blender.bake_groups import bake_groups
 
     for option, given in (("--object", args.object), ("--high-poly", args.high_poly), ("--cage", args.cage),
                           ("--all-meshes", args.all_meshes)):
@@ -220,8 +220,8 @@ def _pick_groups(args, run: _Run, report: Report) -> list:
 
 def _request(args, run: _Run, targets: list, high_poly: list | None, cage, groups: list | None = None):
     """The job's BakeRequest: what to bake, and every file the run reads and writes."""
-    from .blender.bake_job import BakeRequest
-    from .core.imageio import BAKE_KEY
+    from ..blender.bake_job import BakeRequest
+    from ..core.imageio import BAKE_KEY
 
     return BakeRequest(targets=targets, settings=run.settings, options=run.options, frames=run.frames,
                        uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
@@ -264,9 +264,9 @@ def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Pro
 
 def _report_results(job, run: _Run, args, report: Report, seconds: float) -> list[str]:
     """The report's objects, outputs and warnings of a finished job; returns its summary lines."""
-    from .blender.bake_job import output_path_for
-    from .blender.color_attributes import AO_ATTRIBUTE
-    from .blender.paths import frame_pattern
+    from ..blender.bake_job import output_path_for
+    from ..blender.color_attributes import AO_ATTRIBUTE
+    from ..blender.paths import frame_pattern
 
     request, settings = job.request, run.settings
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
@@ -343,7 +343,7 @@ def image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
 
 
 def has_token(path: str) -> bool:
-    from .core.bake.udim import UDIM_TOKEN
+    from ..core.bake.udim import UDIM_TOKEN
     return any(token in path for token in (OBJECT_TOKEN, FRAME_TOKEN, UDIM_TOKEN))
 
 
@@ -358,7 +358,7 @@ def validated(settings, settings_cls):
 
 def fill_input_token(args, path: str) -> None:
     """{input} in the output options becomes the input's cleaned name (input_file_name)."""
-    from .core.output_files import input_file_name
+    from ..core.output_files import input_file_name
     name = input_file_name(path)
     for option in ("out", *EXTRA_OUTPUT_OPTIONS):
         value = getattr(args, option)
@@ -373,6 +373,6 @@ def to_colors(args) -> bool:
 def start_gpu() -> None:
     """Blender's GPU context, made while signals wait (an interrupt inside its creation, which
     runs Python callbacks from C, is not safe)."""
-    from .blender.gpu_context import ensure_gpu_context
+    from ..gpu.context import ensure_gpu_context
     with deferred_signals():
         ensure_gpu_context()

@@ -14,23 +14,23 @@ import sys
 import time
 from pathlib import Path
 
-from . import __version__
-from .cli_bake import fill_input_token, run_bake
-from .cli_batch import run_batch
-from .cli_errors import CLIError, EXIT_FAILURE, EXIT_OK, failure
-from .cli_io import (deferred_signals, EXIT_INTERRUPTED, OpenJDProgress, ProcessOutput, Progress, REPORT, Report,
+from .. import __version__
+from .bake import fill_input_token, run_bake
+from .batch import run_batch
+from .errors import CLIError, EXIT_FAILURE, EXIT_OK, failure
+from .io import (deferred_signals, EXIT_INTERRUPTED, OpenJDProgress, ProcessOutput, Progress, REPORT, Report,
                      signals_as_exceptions)
-from .cli_parser import parse
-from .cli_render import run_render_ao
-from .cli_scene import check_json_target
-from .core.frame_ranges import parse_frames
-from .core.output_files import OutputCollision
+from .parser import parse
+from .render import run_render_ao
+from .scene import check_json_target
+from ..core.frame_ranges import parse_frames
+from ..core.output_files import OutputCollision
 
 
 def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
     """`bake`: one input with --out, or a batch (--out-dir, or several inputs), or a farm
     task's chunk of a manifest (--manifest, --chunk)."""
-    from .cli_farm import check_chunk_without_manifest, take_manifest_chunk
+    from .farm import check_chunk_without_manifest, take_manifest_chunk
     if args.manifest:
         take_manifest_chunk(args)
     else:
@@ -49,7 +49,7 @@ def run_bake_command(args, report: Report, progress: Progress) -> list[str]:
 
 
 def run_farm_command(args, report: Report, progress: Progress) -> list[str]:
-    from .cli_farm import run_farm
+    from .farm import run_farm
     return run_farm(args, report, progress)
 
 
@@ -134,7 +134,7 @@ def _write_report(report: Report, target: str, io: ProcessOutput) -> None:
         check_json_target(target)
     except CLIError:
         return  # that was the error already reported
-    from .core.imageio import atomic_write_bytes
+    from ..core.imageio import atomic_write_bytes
     try:
         atomic_write_bytes(Path(os.path.abspath(target)), text.encode())
     except OSError as exc:

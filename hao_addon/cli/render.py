@@ -6,21 +6,21 @@ import time
 from dataclasses import asdict
 from pathlib import Path
 
-from .cli_bake import start_gpu, validated
-from .cli_errors import CLIError
-from .cli_io import check_signals, Progress, REPORT, Report
-from .cli_options import settings_from_args
-from .cli_parser import INPUT_FORMATS
-from .cli_scene import check_input, check_json_target, load_scene
-from .core.output_files import check_output_files
+from .bake import start_gpu, validated
+from .errors import CLIError
+from .io import check_signals, Progress, REPORT, Report
+from .options import settings_from_args
+from .parser import INPUT_FORMATS
+from .scene import check_input, check_json_target, load_scene
+from ..core.output_files import check_output_files
 
 
 def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     import bpy
 
-    from .core.imageio import check_writable, write_ao_file
-    from .core.hao.view_settings import RenderSize, ViewAOSettings
-    from .render_ao import render_camera_ao
+    from ..core.imageio import check_writable, write_ao_file
+    from ..core.hao.view_settings import RenderSize, ViewAOSettings
+    from ..render_ao import render_camera_ao
 
     size = validated(settings_from_args(args, RenderSize), RenderSize)
     settings = validated(settings_from_args(args, ViewAOSettings), ViewAOSettings)
@@ -48,7 +48,7 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     else:
         camera = scene.camera
     if args.spheres:
-        from .blender.sphere_proxies import has_armature, make_proxies
+        from ..blender.sphere_proxies import has_armature, make_proxies
         rigged = [o for o in scene.objects if o.type == 'MESH' and has_armature(o)]
         if not rigged:
             raise CLIError("--spheres: no mesh with an Armature modifier in the scene")

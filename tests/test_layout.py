@@ -1,0 +1,66 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The house's rules as tests: the floors' import contract (.importlinter, checked by
+import-linter: each floor imports only those below it, the core neither bpy nor gpu, no import
+cycle between sibling modules at any depth) and the linter (ruff.toml). Each check is shown
+to catch the mistake it is for, on a copy of the package with that mistake put in."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+
+BIN = Path(sys.executable).parent
+pytestmark = pytest.mark.release_independent  # the same source on every release
+
+
+def lint_imports(root: Path) -> subprocess.CompletedProcess:
+    """lint-imports over the hao_addon package found under `root`, with the repository's contract."""
+    return subprocess.run([str(BIN / "lint-imports"), "--config", str(ROOT / ".importlinter"), "--no-cache"],
+                          capture_output=True, text=True, cwd=root, timeout=300,
+                          env={**os.environ, "PYTHONPATH": str(root)})
+
+
+def package_copy(tmp_path: Path) -> Path:
+    shutil.copytree(ROOT / "hao_addon", tmp_path / "hao_addon", ignore=shutil.ignore_patterns("__pycache__"))
+    return tmp_path
+
+
+def test_the_floors_import_contract_holds():
+    done = lint_imports(ROOT)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
+    assert "3 kept, 0 broken" in done.stdout
+
+
+@pytest.mark.parametrize("module, line, broken", [
+    ("core/geometry.py", "from ..blender import paths", "The floors"),  # the core climbs to Blender
+    ("gpu/util.py", "from ..cli import errors", "The floors"),  # a pass imports the command line
+    ("core/kernels.py", "import bpy", "The core imports neither bpy nor gpu"),
+    ("core/components.py", "from . import geometry", "No import cycles"),  # geometry imports components
+])
+def test_the_contract_catches_an_import_against_it(tmp_path, module, line, broken):
+    root = package_copy(tmp_path)
+    path = root / "hao_addon" / module
+    path.write_text(path.read_text(encoding="utf-8") + f"\n{line}  # put in by the test\n", encoding="utf-8")
+    done = lint_imports(root)
+    assert done.returncode != 0
+    assert f"{broken}" in done.stdout.split("Broken contracts")[-1], done.stdout[-3000:]
+
+
+def test_ruff_finds_nothing():
+    done = subprocess.run([str(BIN / "ruff"), "check", "--no-cache", "."], capture_output=True, text=True,
+                          cwd=ROOT, timeout=300)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
+
+
+def test_ruff_catches_an_unused_import(tmp_path):
+    (tmp_path / "ruff.toml").write_text((ROOT / "ruff.toml").read_text(encoding="utf-8"), encoding="utf-8")
+    (tmp_path / "bad.py").write_text("import os\n", encoding="utf-8")
+    done = subprocess.run([str(BIN / "ruff"), "check", "--no-cache", "."], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=60)
+    assert done.returncode == 1 and "F401" in done.stdout
