@@ -1,10 +1,33 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The AO tab of the 3D View sidebar."""
+"""The AO tab of the 3D View sidebar. The bake panel is laid out as Cycles' own Bake panel:
+the Bake button and what to bake on top, then sub-panels (Output, Selected to Active, Maps,
+Quality, Advanced; the rarely needed ones collapsed). The Maps sub-panel is drawn from the
+map rows (core/bake/map_kinds.py)."""
 from __future__ import annotations
 
 import bpy
 
+from ..hao_addon.core.bake.map_kinds import EXTRA_MAPS
 from ..hao_addon.core.bake.settings import QUALITY_CAPS
+
+
+def _split_layout(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout.column()
+
+
+def _active_column(col, active: bool):
+    sub = col.column()
+    sub.active = active
+    return sub
+
+
+class _BakeSubPanel:
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "AO"
+    bl_parent_id = "VIEW3D_PT_hao_bake"
 
 
 class VIEW3D_PT_hao_bake(bpy.types.Panel):
@@ -17,63 +40,26 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
     bl_category = "AO"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
         settings = context.scene.hao_bake
-        col = layout.column()
-        col.prop(settings, "size")
-        col.prop(settings, "quality")
-        if settings.quality in QUALITY_CAPS:  # a preset caps itself
-            col.label(text=f"Up to {QUALITY_CAPS[settings.quality]} directions")
-        else:
-            col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
-        sub = col.column()
-        sub.active = settings.quality in ("custom", "fixed")
-        sub.prop(settings, "max_error")
-        col.prop(settings, "method")
-        col.separator()
-        col.prop(settings, "max_distance")
-        sub = col.column()
-        sub.active = settings.max_distance > 0.0
-        sub.prop(settings, "falloff")
-        col.prop(settings, "weighting")
-        col.prop(settings, "spread_angle")
-        col.prop(settings, "min_distance")
-        col.prop(settings, "normals")
-        sub = col.column()
-        sub.active = settings.normals == 'mesh'
-        sub.prop(settings, "terminator")
-        offset = sub.column()
-        offset.active = settings.normals == 'mesh' and settings.terminator == 'setting'
-        offset.prop(settings, "terminator_offset")
-        col.prop(settings, "ignore_back_faces")
-        col.prop(settings, "alpha")
-        sub = col.column()
-        sub.active = settings.alpha == "clip"
-        sub.prop(settings, "alpha_clip")
-        col.prop(settings, "occluders")
-        col.prop(settings, "samples_per_texel")
-        col.separator()
-        col.prop(settings, "selected_to_active")
-        sub = col.column()
-        sub.active = settings.selected_to_active
-        sub.prop(settings, "cage_object")
-        extrusion = sub.column()
-        extrusion.active = settings.selected_to_active and settings.cage_object is None
-        extrusion.prop(settings, "cage_extrusion")
-        sub.prop(settings, "max_ray_distance")
-        col.prop(settings, "match_names")
-        sub = col.column()
-        sub.active = settings.match_names
-        sub.prop(settings, "low_suffix")
-        sub.prop(settings, "high_suffix")
-        sub.prop(settings, "group_occluders")
-        col.separator()
+        self.layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
+        col = _split_layout(self.layout)
         col.prop(settings, "target")
         if settings.target == "color-attribute":
             col.prop(settings, "color_domain")
-        outer, col = col, col.column()
+        col.prop(settings, "size")
+        col.prop(settings, "occluders")
+        col.prop(settings, "method")
+
+
+class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
+    """Where the AO map goes: UV map, image, file, frames, material"""
+
+    bl_label = "Output"
+    bl_idname = "VIEW3D_PT_hao_bake_output"
+
+    def draw(self, context):
+        settings = context.scene.hao_bake
+        col = _split_layout(self.layout)
         col.active = settings.target == "image"  # the image outputs
         col.prop(settings, "uv_mode")
         if settings.uv_mode == 'NAMED':
@@ -86,32 +72,108 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
         col.prop(settings, "filepath")
-        sub = col.column()
-        sub.prop(settings, "png_bits")
-        dither = sub.column()
-        dither.active = settings.png_bits == "8"
-        dither.prop(settings, "dither")
+        col.prop(settings, "png_bits")
+        _active_column(col, settings.png_bits == "8").prop(settings, "dither")
         col.prop(settings, "frame_range")
         col.prop(settings, "wire_material")
-        col.prop(settings, "bent_normals")
-        sub = col.column()
-        sub.active = settings.bent_normals
-        sub.prop(settings, "bent_space")
-        sub.prop(settings, "bent_convention")
-        sub.prop(settings, "bent_filepath")
-        col.prop(settings, "thickness")
-        sub = col.column()
-        sub.active = settings.thickness
-        sub.prop(settings, "thickness_distance")
-        sub.prop(settings, "thickness_filepath")
-        col.prop(settings, "error_filepath")
-        col.prop(settings, "verify")
-        sub = col.column()
-        sub.active = settings.verify > 0
-        sub.prop(settings, "verify_max_error")
-        outer.prop(settings, "view_samples")
-        layout.separator()
-        layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
+
+
+class VIEW3D_PT_hao_bake_selected(_BakeSubPanel, bpy.types.Panel):
+    """Selected to Active, and bake groups matched by name"""
+
+    bl_label = "Selected to Active"
+    bl_idname = "VIEW3D_PT_hao_bake_selected"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.hao_bake, "selected_to_active", text="")
+
+    def draw(self, context):
+        settings = context.scene.hao_bake
+        col = _split_layout(self.layout)
+        sub = _active_column(col, settings.selected_to_active)
+        sub.prop(settings, "cage_object")
+        _active_column(sub, settings.selected_to_active and settings.cage_object is None).prop(settings,
+                                                                                                "cage_extrusion")
+        sub.prop(settings, "max_ray_distance")
+        col.prop(settings, "match_names")
+        sub = _active_column(col, settings.match_names)
+        sub.prop(settings, "low_suffix")
+        sub.prop(settings, "high_suffix")
+        sub.prop(settings, "group_occluders")
+
+
+class VIEW3D_PT_hao_bake_maps(_BakeSubPanel, bpy.types.Panel):
+    """The maps baked beside the AO, one block per map row"""
+
+    bl_label = "Maps"
+    bl_idname = "VIEW3D_PT_hao_bake_maps"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        settings = context.scene.hao_bake
+        col = _split_layout(self.layout)
+        col.active = settings.target == "image"
+        for kind in EXTRA_MAPS:
+            block = col.column()
+            if kind.setting:
+                block.prop(settings, kind.setting)
+                block = _active_column(block, getattr(settings, kind.setting))
+            for name in kind.settings:
+                block.prop(settings, name)
+            block.prop(settings, kind.property_name)
+
+
+class VIEW3D_PT_hao_bake_quality(_BakeSubPanel, bpy.types.Panel):
+    """How exact the map must be, and checking it"""
+
+    bl_label = "Quality"
+    bl_idname = "VIEW3D_PT_hao_bake_quality"
+
+    def draw(self, context):
+        settings = context.scene.hao_bake
+        col = _split_layout(self.layout)
+        col.prop(settings, "quality")
+        if settings.quality in QUALITY_CAPS:  # a preset caps itself
+            col.label(text=f"Up to {QUALITY_CAPS[settings.quality]} directions")
+        else:
+            col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
+        _active_column(col, settings.quality in ("custom", "fixed")).prop(settings, "max_error")
+        col.prop(settings, "view_samples")
+        col.prop(settings, "samples_per_texel")
+        col.prop(settings, "seed")
+        checked = _active_column(col, settings.target == "image")  # texels of a UV layout
+        checked.prop(settings, "verify")
+        _active_column(checked, settings.verify > 0).prop(settings, "verify_max_error")
+
+
+class VIEW3D_PT_hao_bake_advanced(_BakeSubPanel, bpy.types.Panel):
+    """What counts as an occluder and how rays leave the surface"""
+
+    bl_label = "Advanced"
+    bl_idname = "VIEW3D_PT_hao_bake_advanced"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        settings = context.scene.hao_bake
+        col = _split_layout(self.layout)
+        col.prop(settings, "max_distance")
+        _active_column(col, settings.max_distance > 0.0).prop(settings, "falloff")
+        col.prop(settings, "weighting")
+        col.prop(settings, "spread_angle")
+        col.prop(settings, "min_distance")
+        col.prop(settings, "normals")
+        sub = _active_column(col, settings.normals == 'mesh')
+        sub.prop(settings, "terminator")
+        _active_column(sub, settings.normals == 'mesh' and settings.terminator == 'setting').prop(
+            settings, "terminator_offset")
+        col.prop(settings, "ignore_back_faces")
+        col.prop(settings, "alpha")
+        _active_column(col, settings.alpha == "clip").prop(settings, "alpha_clip")
+
+
+BAKE_PANELS = (VIEW3D_PT_hao_bake, VIEW3D_PT_hao_bake_output, VIEW3D_PT_hao_bake_selected, VIEW3D_PT_hao_bake_maps,
+               VIEW3D_PT_hao_bake_quality, VIEW3D_PT_hao_bake_advanced)
 
 
 class VIEW3D_PT_hao_view(bpy.types.Panel):
@@ -169,5 +231,5 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         layout.operator("render.hao_render_ao", icon='RENDER_STILL')
 
 
-classes = (VIEW3D_PT_hao_bake, VIEW3D_PT_hao_view)
+classes = (*BAKE_PANELS, VIEW3D_PT_hao_view)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -11,6 +11,7 @@ from ..hao_addon.blender.bake_groups import bake_groups
 from ..hao_addon.blender.bake_job import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
 from ..hao_addon.core.bake.job_options import JobOptions
+from ..hao_addon.core.bake.map_kinds import EXTRA_MAPS
 from .setting_props import setting_annotations, settings_from
 
 
@@ -41,19 +42,6 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         name="Cage Object", type=bpy.types.Object, poll=lambda _self, obj: obj.type == 'MESH',
         description="Selected to Active: rays start on this copy of the active mesh (same topology, moved "
                     "vertices) instead of the cage extrusion")
-    bent_filepath: StringProperty(
-        name="Save Bent Normals To", description="Also write the bent normals to this .png (16-bit) or .exr file; "
-                                                 "{object} is replaced by the object's name", default="",
-        subtype='FILE_PATH', options=compat.path_property_options())
-    thickness_filepath: StringProperty(
-        name="Save Thickness To", description="Also write the thickness map to this .png (16-bit) or .exr file; "
-                                              "{object} is replaced by the object's name", default="",
-        subtype='FILE_PATH', options=compat.path_property_options())
-    error_filepath: StringProperty(
-        name="Save Error To", description="Also write each texel's estimated error (one standard error, from the "
-                                          "bake's own estimate) to this .exr (float) file; {object} is replaced by "
-                                          "the object's name", default="",
-        subtype='FILE_PATH', options=compat.path_property_options())
     frame_range: BoolProperty(
         name="Frame Range",
         description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
@@ -89,10 +77,16 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                            image=self.image if to_image else None, filepath=self.filepath if to_image else "",
                            wire_material=self.wire_material and to_image,
                            high_poly=high_poly, cage=cage,
-                           bent_filepath=self.bent_filepath if self.bent_normals else "",
-                           thickness_filepath=self.thickness_filepath if self.thickness and to_image else "",
-                           error_filepath=self.error_filepath if to_image else "",
+                           map_paths=self.map_paths(settings),
                            frames=self.scene_frames() if self.frame_range else None)
+
+    def map_paths(self, settings: BakeSettings) -> dict[str, str]:
+        """The Save ... To files of the maps besides the AO (core/bake/map_kinds.py) that this
+        bake writes: image bakes only, each with its setting on where it needs one."""
+        if settings.target != "image":
+            return {}
+        return {kind.key: path for kind in EXTRA_MAPS if (path := getattr(self, kind.property_name))
+                and (not kind.setting or getattr(settings, kind.setting))}
 
     def scene_frames(self) -> list[int]:
         """The frames of the scene this property group belongs to (its frame range and step)."""
@@ -100,8 +94,17 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
         return list(range(scene.frame_start, scene.frame_end + 1, max(1, scene.frame_step)))
 
 
+def map_file_annotations() -> dict:
+    """A Save ... To file field per map besides the AO (core/bake/map_kinds.py)."""
+    return {kind.property_name: StringProperty(
+        name=kind.panel_label, default="", subtype='FILE_PATH', options=compat.path_property_options(),
+        description=f"Also write {kind.help} to this .png (16-bit) or .exr (32-bit float) file; {{object}} is "
+                    f"replaced by the object's name") for kind in EXTRA_MAPS}
+
+
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(JobOptions))
+HAO_PG_bake_settings.__annotations__.update(map_file_annotations())
 
 
 def register() -> None:

@@ -136,12 +136,12 @@ def test_tangent_space_map_decodes_to_the_object_space_map(scene):
     tangents = mesh_data.corner_tangents(ball, dg, uv_name)
     face, bary, _ = texel_surface_samples(target.uvs, result.ao.shape[0])
     valid = result.covered & (face >= 0)
-    c = tangent.bent_images[ball.name][valid, :3] * 2.0 - 1.0
+    c = tangent.maps["bent"][ball.name][valid, :3] * 2.0 - 1.0
     frames = tangent_frames(face[valid], bary[valid], tangents, target.normals)
     world = np.einsum("mk,mkd->md", c, frames)
     linear = np.array(ball.matrix_world)[:3, :3]
     decoded = to_object_space(world, linear)
-    expected = obj_space.bent_images[ball.name][valid, :3] * 2.0 - 1.0
+    expected = obj_space.maps["bent"][ball.name][valid, :3] * 2.0 - 1.0
     assert valid.sum() > 4000 and result.ao[valid].min() < 0.8  # the box bends a part of it
     assert angles_deg(decoded, expected / np.linalg.norm(expected, axis=1, keepdims=True)).max() < 0.05
 
@@ -154,14 +154,14 @@ def test_lone_plane_tangent_map_is_flat_blue_and_directx_flips_green(scene):
     plane.rotation_euler = (0.4, 0.0, 1.0)
     job = _bent_job(scene, plane)
     (_o, _uv, result), = job.results
-    rgb = job.bent_images[plane.name][result.covered, :3]
+    rgb = job.maps["bent"][plane.name][result.covered, :3]
     np.testing.assert_allclose(rgb, np.broadcast_to([0.5, 0.5, 1.0], rgb.shape), atol=0.003)
     images = {i.name for i in job.commit()}
     assert {f"{plane.name}_AO", f"{plane.name}_BentNormals"} <= images
     bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.5, 0.5, 0.3))  # bends the plane's normals
     opengl = _bent_job(scene, plane)
     directx = _bent_job(scene, plane, bent_convention="directx")
-    a, b = opengl.bent_images[plane.name], directx.bent_images[plane.name]
+    a, b = opengl.maps["bent"][plane.name], directx.maps["bent"][plane.name]
     np.testing.assert_allclose(b[..., 1], 1.0 - a[..., 1], atol=1e-6)
     np.testing.assert_array_equal(a[..., [0, 2, 3]], b[..., [0, 2, 3]])
     assert np.abs(a[..., 1] - 0.5).max() > 0.02

@@ -61,11 +61,11 @@ def test_a_sequence_keeps_no_frame_maps_in_memory(gpu_context, tmp_path):
     frames is one frame's maps (its last results), whatever N (issue 28: +8 MB a frame)."""
     man = cesium_man()
     job = run_job(BakeRequest([man], replace(SETTINGS, bent_normals=True), filepath=str(tmp_path / "{frame}.png"),
-                              bent_filepath=str(tmp_path / "bent_{frame}.png"), frames=[1, 5, 9, 13]))
+                              map_paths={"bent": str(tmp_path / "bent_{frame}.png")}, frames=[1, 5, 9, 13]))
     assert len(os.listdir(tmp_path)) == 8
     held = [value for entry in job.frame_results for value in entry.values()]
     assert not any(isinstance(v, np.ndarray) or hasattr(v, "ao") for v in held)  # no maps per frame
-    assert len(job.results) == 1 and job.bent_images == {}  # the last frame's result only
+    assert len(job.results) == 1 and job.maps["bent"] == {}  # the last frame's result only
 
 
 def test_a_static_mesh_over_ten_frames_bakes_once(gpu_context, tmp_path):

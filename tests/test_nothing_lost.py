@@ -96,7 +96,7 @@ def test_a_failure_after_the_maps_are_in_place_puts_the_earlier_files_back(gpu_c
     monkeypatch.setattr(images, "store_map_image", broken_store)
     settings = BakeSettings(size=64, directions=8, margin=2, bent_normals=True)
     job = BakeJob(BakeRequest(objs, settings, filepath=str(tmp_path / "{object}.png"),
-                              bent_filepath=str(tmp_path / "{object}_bent.png")),
+                              map_paths={"bent": str(tmp_path / "{object}_bent.png")}),
                   bpy.context.evaluated_depsgraph_get)
     job.run()
     with pytest.raises(RuntimeError, match="image store failed"):
@@ -263,7 +263,7 @@ def test_tangent_bent_normals_of_n_gons_from_a_triangulated_copy(gpu_context, tm
     bpy.data.meshes.remove(sides)
     np.testing.assert_allclose(tangent[quads], expected, atol=1e-6)
     job = BakeJob(BakeRequest([obj], BakeSettings(size=64, directions=8, bent_normals=True),
-                              filepath=str(tmp_path / "ao.png"), bent_filepath=str(tmp_path / "bent.png"),
+                              filepath=str(tmp_path / "ao.png"), map_paths={"bent": str(tmp_path / "bent.png")},
                               options=JobOptions(bent_space="tangent")), bpy.context.evaluated_depsgraph_get)
     job.run()
     job.commit()

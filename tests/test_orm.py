@@ -69,7 +69,7 @@ def test_material_images_and_values_fill_the_green_and_blue(scene, tmp_path):
     obj.data.materials.append(material)
     select_only(obj)
     request = BakeRequest([obj], BakeSettings(size=32, directions=8, margin=0), uv_map="UVMap",
-                          filepath=str(tmp_path / "ao.exr"), orm_filepath=str(tmp_path / "orm.exr"))
+                          filepath=str(tmp_path / "ao.exr"), map_paths={"orm": str(tmp_path / "orm.exr")})
     job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
     job.run()
     job.commit()

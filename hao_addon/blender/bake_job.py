@@ -33,6 +33,7 @@ from ..core.bake.projection import HighToLow
 from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
 from ..core.bake.job_options import JobOptions
+from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 from ..core.bake.orm import orm_image
 from ..core.bake.tangent_space import bent_normal_map
 from ..core.bake.targets import BakeTarget
@@ -84,8 +85,11 @@ class BakeRequest:
     target's UVs and occlude, the target does not; cage: an optional cage object (the
     target's topology, moved vertices) the rays start from.
     Bent normals (settings.bent_normals): each target also gets an image '<object>_BentNormals'
-    in options.bent_space and options.bent_convention, saved to bent_filepath if given
+    in options.bent_space and options.bent_convention, saved to map_paths["bent"] if given
     (tokens as filepath).
+    map_paths: the files of the maps besides the AO (core/bake/map_kinds.py: key -> path,
+    tokens as filepath): bent normals, thickness (settings.thickness), glTF's ORM texture
+    (with wire_material it replaces the AO in the material's glTF wiring), the error map.
     settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
     instead (settings.color_domain), UV map, image and files unused.
     options.texture_set: the targets, each with its own UVs (not overlapping across objects),
@@ -105,12 +109,7 @@ class BakeRequest:
     source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None
-    bent_filepath: str = ""
-    thickness_filepath: str = ""  # settings.thickness: the thickness map's file (tokens as filepath)
-    error_filepath: str = ""  # the estimated error per texel (BakeResult.error_map), a float image
-    # glTF's occlusion-roughness-metallic texture (core/bake/orm.py) to this file (tokens as
-    # filepath); with wire_material it replaces the AO in the material's glTF wiring.
-    orm_filepath: str = ""
+    map_paths: dict[str, str] = field(default_factory=dict)
     options: JobOptions = field(default_factory=JobOptions)
     frames: list | None = None
     # What else the caller reads and writes, as (path, what) pairs, so that one check
@@ -134,6 +133,10 @@ class BakeRequest:
         """settings.target 'color-attribute': AO into each target's colour attribute hao_ao
         (blender/color_attributes.py), no UV map, image or file."""
         return self.settings.target == "color-attribute"
+
+    def map_path(self, key: str) -> str:
+        """The file pattern of the map `key` (core/bake/map_kinds.py), '' when it is not written."""
+        return self.filepath if key == "ao" else self.map_paths.get(key, "")
 
 
 def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeSettings:
@@ -199,15 +202,18 @@ def validate_request(request: BakeRequest) -> None:
         _validate_texture_set(request)
     elif request.image is not None and len(request.targets) > 1:
         raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
-    if request.bent_filepath and not request.settings.bent_normals:
+    unknown = sorted(set(request.map_paths) - {kind.key for kind in EXTRA_MAPS})
+    if unknown:
+        raise BakeInputError(f"no map '{unknown[0]}' to write: the maps are {', '.join(k.key for k in EXTRA_MAPS)}")
+    if request.map_path("bent") and not request.settings.bent_normals:
         raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
-    if request.orm_filepath and (request.to_color_attribute or request.options.texture_set):
+    if request.map_path("orm") and (request.to_color_attribute or request.options.texture_set):
         raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
                              "texture set)")
-    if request.error_filepath and request.to_color_attribute:
+    if request.map_path("error") and request.to_color_attribute:
         raise BakeInputError("an error map is an image of the UV layout: a colour-attribute bake reports its error "
                              "(--json) but has no error map")
-    if request.thickness_filepath and not request.settings.thickness:
+    if request.map_path("thickness") and not request.settings.thickness:
         raise BakeInputError("a thickness file needs the Thickness setting on")
     if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
                                        or any(g.highs for g in request.groups or ())):
@@ -230,10 +236,7 @@ def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
 
 def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
     """The image files a request writes per target: (kind, path pattern, what, channels)."""
-    return (("ao", request.filepath, "the AO map", 1), ("bent", request.bent_filepath, "the bent normals", 4),
-            ("thickness", request.thickness_filepath, "the thickness map", 1),
-            ("orm", request.orm_filepath, "the ORM texture", 4),
-            ("error", request.error_filepath, "the error map", 1))
+    return tuple((kind.key, request.map_path(kind.key), kind.noun, kind.channels) for kind in MAP_KINDS)
 
 
 def _file_owners(request: BakeRequest) -> list:
@@ -336,7 +339,7 @@ def _validate_groups(request: BakeRequest) -> None:
     if request.to_color_attribute:
         raise BakeInputError("bake groups bake each low-poly into an image (not a colour attribute)")
     if request.options.texture_set and (request.settings.bent_normals or request.settings.thickness
-                                        or request.orm_filepath or request.frames):
+                                        or request.map_path("orm") or request.frames):
         raise BakeInputError("bake groups in one texture set bake the AO of one frame (not bent normals, thickness, "
                              "an ORM texture or frames)")
     if not request.groups:
@@ -379,12 +382,12 @@ class BakeJob:
         self._depsgraph_getter = depsgraph_getter
         self.created_uv: list[tuple[bpy.types.Mesh, str]] = []
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
-        self.bent_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) encoded
-        self.thickness_maps: dict[str, np.ndarray] = {}  # object name -> (size, size) thickness
+        # The maps made beside each result (bent normals (size, size, 4) encoded, thickness
+        # (size, size), the ORM texture (size, size, 4)): map key -> label -> map.
+        self.maps: dict[str, dict[str, np.ndarray]] = {"bent": {}, "thickness": {}, "orm": {}}
         self.own_stats: dict[str, dict] = {}  # bake groups in a texture set: each low-poly's own bake's stats
         # --verify: (label, Verification) of each verified bake (hao_addon/verify.py).
         self.verifications: list[tuple[str, object]] = []
-        self.orm_images: dict[str, np.ndarray] = {}  # object name -> (size, size, 4) ORM texture
         self.written: list[str] = []  # the files in place: commit()'s, or a sequence's finished frames
         self.files: dict[tuple[str, str], list[str]] = {}  # the same by (object name, 'ao' | 'bent')
         # A frame sequence: per frame {frame, seconds, reused, outputs} (its maps are written
@@ -503,16 +506,14 @@ class BakeJob:
                 self.frame_results.append(dict(frame=frame, seconds=round(time.perf_counter() - t0, 4),
                                                reused=all(r.stats.get("cache_hit") for _o, _u, r in self.results),
                                                outputs=outputs))
-                self.bent_images.clear()
-                self.thickness_maps.clear()
-                self.orm_images.clear()
+                self._clear_maps()
         finally:  # also when cancelled: the scene goes back to its frame
             scene.frame_set(original)
         self.finished = True
 
     def _bake_frame(self, uv_names: dict, start: float, share: float, frame: int | None = None
                     ) -> Generator[tuple[float, str], None, None]:
-        """Bake every target at the scene's current frame into self.results (and bent_images);
+        """Bake every target at the scene's current frame into self.results (and self.maps);
         progress runs from start over share of the bar."""
         req = self.request
         depsgraph = self._depsgraph_getter()
@@ -565,11 +566,11 @@ class BakeJob:
                 steps = thickness_steps(soup, settings, use_cache=frame is None)
                 thick = yield from _with_status(steps, start + share * (k + 1) / len(units),
                                                 f"Baking thickness of '{label}'{at}")
-                self.thickness_maps[label] = thick.ao
-            if req.orm_filepath:
-                self.orm_images[label] = self._orm_image(obj, depsgraph, soup, result)
+                self.maps["thickness"][label] = thick.ao
+            if req.map_path("orm"):
+                self.maps["orm"][label] = self._orm_image(obj, depsgraph, soup, result)
             if settings.bent_normals:
-                self.bent_images[label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
+                self.maps["bent"][label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
                                                            soup, result)
             if alpha_notes:
                 result = replace(result, stats={**result.stats,
@@ -693,7 +694,7 @@ class BakeJob:
             self._staged = None
 
     def _stage_files(self, frame: int | None = None) -> StagedFiles:
-        """Every map of self.results (and self.bent_images) staged beside its file, one per
+        """Every map of self.results (and self.maps) staged beside its file, one per
         UDIM tile, after the collision check of the files as they turned out (tiles known);
         self.files lists them by (label, kind)."""
         req = self.request
@@ -714,9 +715,7 @@ class BakeJob:
                         for file_path, source in zip(paths, _tile_paths(earlier, result.tiles)):
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
-                        maps = {"ao": result.ao, "bent": self.bent_images.get(label),
-                                "thickness": self.thickness_maps.get(label), "orm": self.orm_images.get(label),
-                                "error": result.error_map()}[kind]
+                        maps = self._map_of(kind, label, result)
                         if maps is None:
                             continue
                         for file_path, tile_map in zip(paths, [maps] if result.tiles is None else maps):
@@ -727,6 +726,19 @@ class BakeJob:
             staged.discard()
             raise
         return staged
+
+    def _map_of(self, key: str, label: str, result: BakeResult) -> np.ndarray | None:
+        """The map `key` of one label's finished bake: the AO and the error map from its result,
+        the others as the job made them (self.maps); None where it was not made."""
+        if key == "ao":
+            return result.ao
+        if key == "error":
+            return result.error_map()
+        return self.maps[key].get(label)
+
+    def _clear_maps(self) -> None:
+        for made in self.maps.values():
+            made.clear()
 
     def _write_frame(self, frame: int) -> list[str]:
         """Write the finished frame's files (all or none); returns them."""
@@ -749,13 +761,12 @@ class BakeJob:
             existing = req.image or bpy.data.images.get(name)
             stored[label] = self._store_image(result.ao, result.tiles, name, existing, files.get((label, "ao")))
             self.committed.append(stored[label])
-            for kind, maps, suffix in (("bent", self.bent_images, "BentNormals"),
-                                       ("thickness", self.thickness_maps, "Thickness"), ("orm", self.orm_images, "ORM")):
-                if label in maps:
-                    name = f"{label}_{suffix}"
-                    extra[label, kind] = self._store_image(maps[label], result.tiles, name, bpy.data.images.get(name),
-                                                           files.get((label, kind)))
-                    self.committed.append(extra[label, kind])
+            for kind in EXTRA_MAPS:
+                if kind.image_suffix and label in self.maps.get(kind.key, {}):
+                    name = f"{label}_{kind.image_suffix}"
+                    extra[label, kind.key] = self._store_image(self.maps[kind.key][label], result.tiles, name,
+                                                               bpy.data.images.get(name), files.get((label, kind.key)))
+                    self.committed.append(extra[label, kind.key])
         for obj, uv_name, _result in self.results:
             image = stored[self.label_of(obj)]
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
@@ -816,6 +827,4 @@ class BakeJob:
                 mesh.uv_layers.remove(layer)
         self.created_uv.clear()
         self.results.clear()
-        self.bent_images.clear()
-        self.thickness_maps.clear()
-        self.orm_images.clear()
+        self._clear_maps()

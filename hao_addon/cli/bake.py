@@ -13,6 +13,7 @@ from .options import option_for, settings_from_args
 from .parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
 from .scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
                         export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
+from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 from ..core.frame_ranges import parse_frames
 from ..core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
 from ..core.setting_spec import SettingError
@@ -90,18 +91,13 @@ def _checked_run(args, report: Report) -> _Run:
         options = ", ".join("--" + option.replace("_", "-") for option in IMAGE_OPTIONS)
         raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out (.blend, .glb "
                        f"or .ply); {options} and --gltf-out are image bakes")
-    if args.bent_normal_out:
-        settings = replace(settings, bent_normals=True)
-        check_writable(example_path(args.bent_normal_out, first_frame), settings.size, settings.size, 4,
-                       source=source)
-    if args.thickness_out:
-        settings = replace(settings, thickness=True)
-        check_writable(example_path(args.thickness_out, first_frame), settings.size, settings.size, 1,
-                       source=source)
-    if args.error_out:
-        check_writable(example_path(args.error_out, first_frame), settings.size, settings.size, 1, source=source)
-    if args.orm_out:
-        check_writable(example_path(args.orm_out, first_frame), settings.size, settings.size, 4, source=source)
+    for kind in EXTRA_MAPS:
+        path = getattr(args, kind.option)
+        if not path:
+            continue
+        if kind.setting:  # its file asks for it: --bent-normal-out turns Bent Normals on
+            settings = replace(settings, **{kind.setting: True})
+        check_writable(example_path(path, first_frame), settings.size, settings.size, kind.channels, source=source)
     gltf_out = check_gltf_target(args.gltf_out, source) if args.gltf_out else None
     report.settings = {**asdict(settings), "uv_map": args.uv_map, "occluders": args.occluders}
     report.input = str(source)
@@ -227,10 +223,8 @@ def _request(args, run: _Run, targets: list, high_poly: list | None, cage, group
                        uv_map="AUTO" if args.uv_map.lower() == "auto" else args.uv_map,
                        filepath="" if run.to_colors else str(Path(os.path.abspath(args.out))),
                        source_path=str(run.source), high_poly=high_poly, cage=cage, groups=groups,
-                       bent_filepath=str(Path(os.path.abspath(args.bent_normal_out))) if args.bent_normal_out else "",
-                       thickness_filepath=str(Path(os.path.abspath(args.thickness_out))) if args.thickness_out else "",
-                       error_filepath=str(Path(os.path.abspath(args.error_out))) if args.error_out else "",
-                       orm_filepath=str(Path(os.path.abspath(args.orm_out))) if args.orm_out else "",
+                       map_paths={kind.key: str(Path(os.path.abspath(getattr(args, kind.option))))
+                                  for kind in EXTRA_MAPS if getattr(args, kind.option)},
                        wire_material=run.gltf_out is not None,
                        extra_inputs=run.reads + list(getattr(args, "batch_inputs", [])),
                        extra_outputs=run.writes, claimed=list(getattr(args, "batch_outputs", [])),
@@ -277,10 +271,8 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
         tile_files = job.files.get((label, "ao"), [])
         if not request.frames:  # a sequence's files are listed frame by frame (_report_frames)
             report.outputs.extend(tile_files if len(tile_files) > 1 else [output_path_for(request, obj)])
-            report.outputs.extend(job.files.get((label, "bent"), []))
-            report.outputs.extend(job.files.get((label, "thickness"), []))
-            report.outputs.extend(job.files.get((label, "orm"), []))
-            report.outputs.extend(job.files.get((label, "error"), []))
+            for kind in EXTRA_MAPS:
+                report.outputs.extend(job.files.get((label, kind.key), []))
         report.warnings.extend(st.get("warnings", []))
         uv_name = next(uv for o, uv, _r in job.results if o == obj)
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
@@ -337,9 +329,7 @@ def image_outputs(args, to_colors: bool) -> list[tuple[str, str]]:
     """The image files named on the command line (patterns, tokens unfilled)."""
     if to_colors:
         return []
-    return [(args.out, "the AO map (--out)"), (args.bent_normal_out or "", "the bent normals (--bent-normal-out)"),
-            (args.thickness_out or "", "the thickness map (--thickness-out)"),
-            (args.orm_out or "", "the ORM texture (--orm-out)"), (args.error_out or "", "the error map (--error-out)")]
+    return [(args.out if kind.key == "ao" else getattr(args, kind.option) or "", kind.what) for kind in MAP_KINDS]
 
 
 def has_token(path: str) -> bool:

@@ -11,6 +11,7 @@ from .. import __version__
 from .errors import CLIError
 from .io import ProcessOutput
 from .options import add_setting_options
+from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 
 
 # A batch's file names in --out-dir, unless --out gives them ({input}: the input's name without
@@ -62,10 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # --maps: each map's own output option (argparse dest), its file named after --out with _MAP.
-MAP_OUTPUTS = {"ao": "", "bent-normal": "bent_normal_out", "thickness": "thickness_out", "orm": "orm_out",
-               "error": "error_out"}
+MAP_OUTPUTS = {kind.name: kind.option for kind in MAP_KINDS}
 # The image options besides --out (each an image bake: not with a colour attribute).
-IMAGE_OPTIONS = tuple(option for option in MAP_OUTPUTS.values() if option)
+IMAGE_OPTIONS = tuple(kind.option for kind in EXTRA_MAPS)
 # Every output option besides --out and --json: the maps' and the glTF file.
 EXTRA_OUTPUT_OPTIONS = (*IMAGE_OPTIONS, "gltf_out")
 
@@ -108,27 +108,15 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
     b.add_argument("--cage", default="", metavar="NAME",
                    help="Selected to Active: a mesh in INPUT with the low-poly's topology that the rays start from "
                         "(instead of --cage-extrusion)")
-    b.add_argument("--bent-normal-out", default="", metavar="FILE",
-                   help="also bake bent normals (the cosine-weighted mean unoccluded direction, same pass) into "
-                        "this .png (16-bit) or .exr (32-bit float) RGB file, 0.5 + 0.5 n; {object} as in --out")
     b.add_argument("--maps", default="", metavar="MAP[,MAP...]",
                    help="the maps to bake, comma-separated, from " + ", ".join(MAP_OUTPUTS) + " (the AO always): "
                         "each map without its own --...-out option is written beside --out, its name followed by "
                         "_MAP (ao.png -> ao_thickness.png); bent normals and the ORM texture come from the AO's "
                         "own pass, thickness from a second one")
-    b.add_argument("--thickness-out", default="", metavar="FILE",
-                   help="also bake thickness (the occlusion of the inverted hemisphere by the mesh itself within "
-                        "--thickness-distance; 1 thin, 0 nothing within reach) into this .png (16-bit) or .exr "
-                        "(32-bit float) file; {object} as in --out")
-    b.add_argument("--error-out", default="", metavar="FILE",
-                   help="also write each texel's estimated error (the RMS of the bake's own error estimate over its "
-                        "5 x 5 neighbourhood: one standard error) into this .exr (32-bit float) or .png file; "
-                        "{object} as in --out")
-    b.add_argument("--orm-out", default="", metavar="FILE",
-                   help="also write glTF's occlusion-roughness-metallic texture: R the AO, G and B the material's "
-                        "roughness and metallic (values or image textures) in the baked UV layout, .png (16-bit, "
-                        "or --png-bits 8) or .exr; with --gltf-out the .glb's material uses it for occlusion, "
-                        "roughness and metallic; {object} as in --out")
+    for kind in EXTRA_MAPS:
+        b.add_argument(kind.flag, default="", metavar="FILE",
+                       help=f"also bake {kind.help}, into this .png (16-bit) or .exr (32-bit float) file"
+                            f"{'; ' + kind.note if kind.note else ''}; {{object}} as in --out")
     b.add_argument("--gltf-out", default="", metavar="FILE.glb",
                    help="also write the baked object as a .glb with the map as its material's occlusionTexture "
                         "(Blender's glTF exporter; the map on the UV map that was baked)")

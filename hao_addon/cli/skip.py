@@ -13,13 +13,14 @@ from dataclasses import replace
 from pathlib import Path
 
 from .. import __version__
+from ..core.bake.map_kinds import EXTRA_MAPS
 
 # Options that name files or steer the run, not what the pixels are: a farm task and a
 # local run of the same bake (other paths, a chunk of the frames) share the key, so their
 # files are byte for byte the same.
 NOT_IN_KEY = frozenset({"command", "input", "out", "out_dir", "json", "quiet", "skip_existing", "frames",
-                        "bent_normal_out", "thickness_out", "orm_out", "error_out", "maps", "gltf_out", "high_poly", "batch_inputs", "batch_outputs", "progress",
-                        "manifest", "chunk", "input_root"})
+                        *(kind.option for kind in EXTRA_MAPS), "maps", "gltf_out", "high_poly", "batch_inputs",
+                        "batch_outputs", "progress", "manifest", "chunk", "input_root"})
 
 
 def file_digest(path: Path) -> bytes:
@@ -40,10 +41,8 @@ def run_key(args, input_files: list[Path]) -> str:
     for path in input_files:
         h.update(file_digest(path))
     options = {name: value for name, value in vars(args).items() if name not in NOT_IN_KEY}
-    options["bent_normals_file"] = bool(args.bent_normal_out)
-    options["thickness_file"] = bool(getattr(args, "thickness_out", ""))
-    options["orm_file"] = bool(getattr(args, "orm_out", ""))
-    options["error_file"] = bool(getattr(args, "error_out", ""))
+    for kind in EXTRA_MAPS:  # which maps are written counts, not where
+        options[kind.skip_key] = bool(getattr(args, kind.option, ""))
     options["high_poly_names"] = [spec for spec in args.high_poly or () if not Path(spec).is_file()]
     h.update(json.dumps(options, sort_keys=True, default=str).encode())
     return h.hexdigest()
