@@ -200,6 +200,25 @@ def spread_warning(settings: BakeSettings, directions: int) -> str:
             f"raise the spread angle or Directions (about {MIN_DIRECTIONS_IN_CONE / share:.3g})")
 
 
+def _finished_maps(plan, sums: np.ndarray) -> tuple:
+    """(ao, covered, filled, bent normals or None) of a bake's summed estimator: the map from
+    its sums with margins and seams (core/bake/seams.py), one per UDIM tile where tiled, or
+    the colour attribute's values, one per element."""
+    margin = plan.settings.margin
+    if plan.vertex_target is not None:
+        return (*element_values(*plan.estimator.ratio(sums)), None)
+    tiles = sums if plan.udim is not None else sums[None]  # each tile with its own margins
+    maps = [finalize_map(*plan.estimator.ratio(tile), margin) for tile in tiles]
+    ao, covered, filled = (np.stack(part) for part in zip(*maps))
+    bent = None
+    if plan.estimator is BENT_NORMALS:
+        bent = np.stack([finalize_vectors(BENT_NORMALS.bent(tile), c, f, margin)
+                         for tile, c, f in zip(tiles, covered, filled)])
+    if plan.udim is None:
+        return ao[0], covered[0], filled[0], None if bent is None else bent[0]
+    return ao, covered, filled, bent
+
+
 def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                    shared: dict | None = None) -> Generator[float, None, BakeResult]:
     """bake_steps without its cache: plan, run the baker's directions, finish the output.
@@ -243,22 +262,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
                                                (sums_b if sums_a is None else sums_a, sums_b))
     finally:
         baker.free()
-    # Output: the estimator's map from its sums, margins and seams (core/bake/seams.py), or
-    # the colour attribute's values, one per element.
-    bent = None
+    ao, covered, filled, bent = _finished_maps(plan, sums)
     twin = None if sums_a is None else replicate_twin(*plan.estimator.ratio(sums_a), *plan.estimator.ratio(sums_b))
-    if plan.vertex_target is not None:
-        ao, covered, filled = element_values(*plan.estimator.ratio(sums))
-    else:  # one map, or one per UDIM tile, each with its own margins
-        tiles = sums if plan.udim is not None else sums[None]
-        maps = [finalize_map(*plan.estimator.ratio(tile), settings.margin) for tile in tiles]
-        ao, covered, filled = (np.stack(part) for part in zip(*maps))
-        if plan.estimator is BENT_NORMALS:
-            bent = np.stack([finalize_vectors(BENT_NORMALS.bent(tile), c, f, settings.margin)
-                             for tile, c, f in zip(tiles, covered, filled)])
-        if plan.udim is None:
-            ao, covered, filled = ao[0], covered[0], filled[0]
-            bent = None if bent is None else bent[0]
     if twin is not None:
         twin = np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
     error = None if twin is None else estimate(twin, covered, count)
@@ -319,18 +324,26 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             cells = np.flatnonzero(active) if active.any() else None
             work += size * float(combined.covered.sum())
             skipped += size * float(combined.covered.sum() - active.sum())
+    skipping = {"rounds": [n for n, _r in rounds], "skippable_fraction": skipped / work if work else 0.0,
+                "skipped_converged": SKIP_CONVERGED and skips and skipped > 0.0,
+                **({"bakes_all_cells": declaration(rounds[0][1].stats["method"]).bakes_all_cells} if not skips else {})}
+    return _to_error_result(combined, settings, stat_target, done, skipping, target.name)
+
+
+def _to_error_result(combined: BakeResult, settings: BakeSettings, stat_target: float, done: int, skipping: dict,
+                     name: str) -> BakeResult:
+    """The rounds' combined result with its error marked capped where the twins' p99 is still
+    above stat_target, and the directions the target needs by the measured rate (a warning)."""
+    target_error = settings.error_target
     capped = combined.error is not None and combined.error.p99 > stat_target
     error = None if combined.error is None else replace(combined.error, capped=capped)
-    method = rounds[0][1].stats["method"]
     stats = {**combined.stats, "error": None if error is None else error.as_dict(), "error_target": target_error,
-             "rounds": [n for n, _r in rounds], "skippable_fraction": skipped / work if work else 0.0,
-             "skipped_converged": SKIP_CONVERGED and skips and skipped > 0.0,
-             **({"bakes_all_cells": declaration(method).bakes_all_cells} if not skips else {})}
+             **skipping}
     if capped:
         needed = directions_for(error.p99, done, target_error)
         stats["directions_needed"] = int(math.ceil(needed))
         stats["warnings"] = [*stats.get("warnings", []),
-                             f"'{target.name}': the estimated p99 error {error.p99:.2g} is above the target "
+                             f"'{name}': the estimated p99 error {error.p99:.2g} is above the target "
                              f"{target_error:.2g} after {done} directions (the cap); by the measured rate it needs "
                              f"about {needed:.3g} directions"
                              + ("" if settings.quality in QUALITY_CAPS else ": raise Directions")]

@@ -8,7 +8,7 @@ from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringPropert
 
 from ..hao_addon import compat
 from ..hao_addon.blender.bake_groups import bake_groups
-from ..hao_addon.blender.bake_job import BakeRequest
+from ..hao_addon.blender.bake_request import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
 from ..hao_addon.core.bake.job_options import JobOptions
 from ..hao_addon.core.bake.map_kinds import EXTRA_MAPS

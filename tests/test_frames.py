@@ -14,7 +14,8 @@ import numpy as np
 import bpy
 from conftest import run_hao
 from hao_addon.bake import clear_cache
-from hao_addon.blender.bake_job import BakeJob, BakeRequest
+from hao_addon.blender.bake_job import BakeJob
+from hao_addon.blender.bake_request import BakeRequest
 from hao_addon.core.bake.settings import BakeSettings
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -83,7 +83,7 @@ def test_uniform_structs_are_generated_from_their_dtypes():
     """A block's GLSL struct is its numpy dtype's (one layout, written once); a dtype that
     std140 would pad differently is refused rather than generated wrong."""
     import numpy as np
-    from hao_addon.gpu.bake_gather import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE
+    from hao_addon.gpu.gather_shaders import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE
     from hao_addon.gpu.hao_sampling import CASCADES_DTYPE
     from hao_addon.gpu.shaders import SHADER_DIR, glsl_struct
     assert glsl_struct("GatherViews", GATHER_VIEWS_DTYPE).splitlines()[1:3] == [
@@ -100,7 +100,8 @@ def test_uniform_structs_are_generated_from_their_dtypes():
 def test_constants_reach_glsl_from_python_only():
     """Each constant the GPU and its numpy mirror share is written once, in Python."""
     from hao_addon.core.hao.ao_pattern import GLSL_DEFINES
-    from hao_addon.gpu.bake_gather import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE, VIEWS_PER_DISPATCH
+    from hao_addon.gpu.bake_gather import VIEWS_PER_DISPATCH
+    from hao_addon.gpu.gather_shaders import GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE
     from hao_addon.gpu.shaders import SHADER_DIR
     sources = {p.name: p.read_text() for p in SHADER_DIR.iterdir()}
     for name, value in GLSL_DEFINES.items():

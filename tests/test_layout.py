@@ -64,3 +64,33 @@ def test_ruff_catches_an_unused_import(tmp_path):
     done = subprocess.run([str(BIN / "ruff"), "check", "--no-cache", "."], capture_output=True, text=True,
                           cwd=tmp_path, timeout=60)
     assert done.returncode == 1 and "F401" in done.stdout
+
+
+MAX_FILE_LINES = 500
+MAX_FUNCTION_LINES = 60
+
+
+def oversized(paths) -> list[str]:
+    """The files over MAX_FILE_LINES lines and the functions over MAX_FUNCTION_LINES among `paths`."""
+    import ast
+    found = []
+    for path in paths:
+        text = Path(path).read_text(encoding="utf-8")
+        if len(text.splitlines()) > MAX_FILE_LINES:
+            found.append(f"{path}: {len(text.splitlines())} lines")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                length = node.end_lineno - node.lineno + 1
+                if length > MAX_FUNCTION_LINES:
+                    found.append(f"{path}:{node.lineno} {node.name}: {length} lines")
+    return found
+
+
+def test_no_product_file_or_function_is_too_long_to_read(tmp_path):
+    """Small modules with one job, functions short enough to read at once: no product file
+    over 500 lines, no function over 60 (a 61-line function is caught)."""
+    product = [*(ROOT / "hao_addon").rglob("*.py"), *(ROOT / "operators").rglob("*.py"), ROOT / "__init__.py"]
+    assert oversized(product) == []
+    long = tmp_path / "long.py"
+    long.write_text("def f():\n" + "    x = 1\n" * 59 + "    return x\n", encoding="utf-8")
+    assert oversized([long]) == [f"{long}:1 f: 61 lines"]

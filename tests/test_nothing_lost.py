@@ -20,7 +20,8 @@ import bpy
 from conftest import ROOT, run_hao, select_only, small_settings
 from hao_addon.bake import clear_cache
 from hao_addon.blender import images, mesh_data
-from hao_addon.blender.bake_job import BakeJob, BakeRequest
+from hao_addon.blender.bake_job import BakeJob
+from hao_addon.blender.bake_request import BakeRequest
 from hao_addon.blender.color_attributes import AO_ATTRIBUTE
 from hao_addon.core.bake.job_options import JobOptions
 from hao_addon.core.bake.settings import BakeSettings

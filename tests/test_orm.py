@@ -44,7 +44,8 @@ def test_material_images_and_values_fill_the_green_and_blue(scene, tmp_path):
     """Roughness from an image's green through Separate Color (as the glTF importer wires a
     metallicRoughness texture), metallic a value: G and B carry them texel for texel."""
     from conftest import select_only, soup_to_object
-    from hao_addon.blender.bake_job import BakeJob, BakeRequest
+    from hao_addon.blender.bake_job import BakeJob
+    from hao_addon.blender.bake_request import BakeRequest
     from hao_addon.core import scenes
     from hao_addon.core.bake.settings import BakeSettings
 

@@ -134,7 +134,8 @@ def test_blender_bakes_use_each_objects_own_terminator_offset(scene):
     import bpy
     from conftest import small_settings, soup_to_object
     from hao_addon import compat
-    from hao_addon.blender.bake_job import BakeJob, terminator_settings
+    from hao_addon.blender.bake_job import BakeJob
+    from hao_addon.blender.bake_request import terminator_settings
 
     obj = soup_to_object(_smooth_sphere(), "Ball")
     for poly in obj.data.polygons:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..core.bake.job_options import JobOptions
 from ..core.bake.name_groups import match_groups
-from .bake_job import BakeGroup
+from .bake_request import BakeGroup
 
 
 def collection_name(obj) -> str:

@@ -11,54 +11,31 @@ sequence keeps its finished frames, listed in ``written``).
 """
 from __future__ import annotations
 
-import glob
-import os
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Generator
 
 import bpy
 import numpy as np
 
-from .. import compat
 from ..bake import BakeResult, bake_key, bake_steps, thickness_steps
 from ..core.steps import relay
 from ..core.bake.error_estimate import estimate
 from ..verify import verify_steps
-from ..core.file_checks import image_is_whole, output_is_whole
-from ..core.imageio import BAKE_KEY, FORMATS, StagedFiles, check_writable, read_text
-from ..core.output_files import check_output_files, frame_file, with_token
+from ..core.imageio import StagedFiles
+from ..core.output_files import check_output_files
 from ..core.bake.projection import HighToLow
-from ..core.errors import BakeInputError
 from ..core.bake.settings import BakeSettings
-from ..core.bake.job_options import JobOptions
-from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
-from ..core.bake.orm import orm_image
-from ..core.bake.tangent_space import bent_normal_map
+from ..core.bake.map_kinds import EXTRA_MAPS
 from ..core.bake.targets import BakeTarget
 from ..core.bake.texture_set import texture_set_target
-from ..core.bake.udim import tile_path, udim_layout
-from ..core.geometry import TriangleSoup, face_normals_areas
 from ..core.bake.unwrap import check_unwrap_overlap, unwrap_steps
 from . import color_attributes, images, mesh_data
-from .material_channels import roughness_metallic
-from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
+from .bake_request import (TEXTURE_SET_NAME, BakeGroup, BakeRequest, input_files, output_kinds, output_path_for,
+                           planned_files, terminator_settings, tile_paths, validate_request)
+from .map_producers import bent_normal_image, orm_map
 from .view_scene import BAKED_AO_PROPERTY
-
-# What a texture set's image and files are named after (JobOptions.texture_set).
-TEXTURE_SET_NAME = "TextureSet"
-
-
-@dataclass
-class BakeGroup:
-    """A bake group (core/bake/name_groups.py): each low-poly is baked from the highs
-    (Selected to Active), or, without highs, as itself."""
-
-    name: str
-    lows: list
-    highs: list
-
 
 @dataclass
 class BakeUnit:
@@ -70,302 +47,6 @@ class BakeUnit:
     objects: list
     sources: list | None
     occluders: list
-
-
-@dataclass
-class BakeRequest:
-    """targets: mesh objects to bake. occluders: 'TARGET' (self only), 'SELECTED' (the other
-    selected meshes too) or 'VISIBLE' (every visible mesh). uv_map: a UV map name, '' for the
-    active render UV map, or 'AUTO': AO_UV if present, else the first UV map, else a new
-    AO_UV unwrapped automatically (core/bake/unwrap.py).
-    image: an existing image to overwrite (one target only), else '<object>_AO' is created.
-    filepath: '' or a .png/.exr path; '{object}' in it becomes each object's name (with several
-    targets and no token, '_{object}' is appended).
-    high_poly: Selected to Active (Cycles' definition): these meshes are baked onto the one
-    target's UVs and occlude, the target does not; cage: an optional cage object (the
-    target's topology, moved vertices) the rays start from.
-    Bent normals (settings.bent_normals): each target also gets an image '<object>_BentNormals'
-    in options.bent_space and options.bent_convention, saved to map_paths["bent"] if given
-    (tokens as filepath).
-    map_paths: the files of the maps besides the AO (core/bake/map_kinds.py: key -> path,
-    tokens as filepath): bent normals, thickness (settings.thickness), glTF's ORM texture
-    (with wire_material it replaces the AO in the material's glTF wiring), the error map.
-    settings.target 'color-attribute': each target's AO goes into its colour attribute hao_ao
-    instead (settings.color_domain), UV map, image and files unused.
-    options.texture_set: the targets, each with its own UVs (not overlapping across objects),
-    bake together into one shared image 'TextureSet_AO' ({object} in file names: 'TextureSet').
-    frames: a frame sequence: the scene is set to each frame in turn (restored after), each
-    frame's maps go to files ({frame} in the paths, zero-padded; '_{frame}' added otherwise),
-    no image datablocks; a frame whose evaluated geometry equals an earlier one reuses its
-    bake (the bake cache)."""
-
-    targets: list
-    settings: BakeSettings
-    uv_map: str = "AUTO"
-    image: "bpy.types.Image | None" = None
-    image_name: str = ""
-    filepath: str = ""
-    wire_material: bool = False
-    source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
-    high_poly: list | None = None
-    cage: "bpy.types.Object | None" = None
-    map_paths: dict[str, str] = field(default_factory=dict)
-    options: JobOptions = field(default_factory=JobOptions)
-    frames: list | None = None
-    # What else the caller reads and writes, as (path, what) pairs, so that one check
-    # (core/output_files.py) sees every file of the run: the CLI's --json report, --gltf-out,
-    # a colour bake's mesh file, high-poly files, a batch's other inputs.
-    extra_inputs: list = field(default_factory=list)
-    extra_outputs: list = field(default_factory=list)
-    # Files others write (a batch's earlier inputs' outputs): this run must not write them.
-    claimed: list = field(default_factory=list)
-    # Bake groups matched by name (options.match_names): every low-poly of each group is a
-    # target (targets lists them all), baked from its group's highs; None: no groups.
-    groups: list[BakeGroup] | None = None
-    # Warnings from making the request (bake groups: the names that matched nothing).
-    notes: list[str] = field(default_factory=list)
-    # Text entries every image file of the run carries (core/imageio.py's BAKE_KEY: what made
-    # it, for --skip-existing).
-    file_text: dict = field(default_factory=dict)
-
-    @property
-    def to_color_attribute(self) -> bool:
-        """settings.target 'color-attribute': AO into each target's colour attribute hao_ao
-        (blender/color_attributes.py), no UV map, image or file."""
-        return self.settings.target == "color-attribute"
-
-    def map_path(self, key: str) -> str:
-        """The file pattern of the map `key` (core/bake/map_kinds.py), '' when it is not written."""
-        return self.filepath if key == "ao" else self.map_paths.get(key, "")
-
-
-def terminator_settings(settings: BakeSettings, receiver_objects: list) -> BakeSettings:
-    """settings with the terminator offset Cycles would use for these objects (the target, or
-    the high-poly sources whose points receive in Selected to Active): each object's own
-    where settings.terminator is 'object' and Blender has the property; several sources
-    with different offsets bake with the largest."""
-    if settings.terminator != "object":
-        return settings
-    offsets = [o for o in map(compat.object_terminator_offset, receiver_objects) if o is not None]
-    return replace(settings, terminator_offset=max(offsets)) if offsets else settings
-
-
-def output_path_for(request: BakeRequest, obj, filepath: str | None = None, frame: int | None = None) -> str:
-    """The file an object's map is saved to (request.filepath, or the given one): '{object}'
-    becomes its name; with several targets and no token, '_{object}' is added before the
-    extension. A frame sequence: '{frame}' becomes the frame (zero-padded; '_{frame}' is added
-    where the path has none); frame None leaves the token (for checks)."""
-    filepath = request.filepath if filepath is None else filepath
-    if not filepath:
-        return ""
-    path = absolute_path(filepath)
-    if request.frames:
-        path = with_token(path, FRAME_TOKEN)
-    if frame is not None:
-        path = frame_file(path, frame)
-    if request.options.texture_set:
-        return path.replace(OBJECT_TOKEN, TEXTURE_SET_NAME)
-    if len(request.targets) > 1:
-        path = with_token(path, OBJECT_TOKEN)
-    return path.replace(OBJECT_TOKEN, object_file_name(obj))
-
-
-def validate_request(request: BakeRequest) -> None:
-    """Raise BakeInputError for anything that can be refused before touching the scene."""
-    request.settings.validated()
-    if request.groups is not None:
-        _validate_groups(request)
-    elif request.high_poly is not None:
-        _validate_high_to_low(request)
-    elif request.cage is not None:
-        raise BakeInputError("a cage object is used only with Selected to Active")
-    if not request.targets:
-        raise BakeInputError("no mesh selected: select one or more mesh objects to bake")
-    if request.to_color_attribute:
-        _validate_color_attribute(request)
-    for obj in request.targets:
-        if obj.type != 'MESH':
-            raise BakeInputError(f"'{obj.name}' is not a mesh")
-        if len(obj.data.polygons) == 0:
-            raise BakeInputError(f"'{obj.name}' has no faces to bake")
-        if request.to_color_attribute:
-            continue
-        name = request.uv_map
-        if name not in ("", "AUTO") and name not in obj.data.uv_layers:
-            raise BakeInputError(f"'{obj.name}' has no UV map named '{name}'")
-        if name == "" and not obj.data.uv_layers:
-            raise BakeInputError(f"'{obj.name}' has no UV map: choose Auto to unwrap it")
-    request.options.validated()
-    if request.frames is not None:
-        _validate_frames(request)
-    if request.options.texture_set:
-        _validate_texture_set(request)
-    elif request.image is not None and len(request.targets) > 1:
-        raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
-    unknown = sorted(set(request.map_paths) - {kind.key for kind in EXTRA_MAPS})
-    if unknown:
-        raise BakeInputError(f"no map '{unknown[0]}' to write: the maps are {', '.join(k.key for k in EXTRA_MAPS)}")
-    if request.map_path("bent") and not request.settings.bent_normals:
-        raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
-    if request.map_path("orm") and (request.to_color_attribute or request.options.texture_set):
-        raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
-                             "texture set)")
-    if request.map_path("error") and request.to_color_attribute:
-        raise BakeInputError("an error map is an image of the UV layout: a colour-attribute bake reports its error "
-                             "(--json) but has no error map")
-    if request.map_path("thickness") and not request.settings.thickness:
-        raise BakeInputError("a thickness file needs the Thickness setting on")
-    if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
-                                       or any(g.highs for g in request.groups or ())):
-        raise BakeInputError("thickness bakes the mesh's own surface into an image (not a colour attribute or "
-                             "Selected to Active)")
-    size = request.settings.size
-    for obj in _file_owners(request):
-        for _kind, filepath, _what, channels in output_kinds(request):
-            path = output_path_for(request, obj, filepath)
-            if path:
-                check_writable(example_path(path, (request.frames or [0])[0]), size, size, channels,
-                               source=request.source_path or None)
-    check_output_files(planned_files(request) + list(request.claimed), input_files(request))
-
-
-def _tile_paths(path: str, tiles: tuple[int, ...] | None) -> list[str]:
-    """The files of one map: path, or one per UDIM tile (tile_path)."""
-    return [path] if tiles is None else [tile_path(path, t) for t in tiles]
-
-
-def output_kinds(request: BakeRequest) -> tuple[tuple[str, str, str, int], ...]:
-    """The image files a request writes per target: (kind, path pattern, what, channels)."""
-    return tuple((kind.key, request.map_path(kind.key), kind.noun, kind.channels) for kind in MAP_KINDS)
-
-
-def _file_owners(request: BakeRequest) -> list:
-    """The targets whose files are written: every target, or a texture set's first (shared)."""
-    return request.targets[:1] if request.options.texture_set else request.targets
-
-
-def planned_files(request: BakeRequest, tiles: dict | None = None) -> list[tuple[str, str]]:
-    """Every file the request writes, as (path, what): each target's maps and bent normals
-    (each frame's, each UDIM tile's where tiles {label: tile numbers} is given), then the
-    caller's extra_outputs."""
-    out = []
-    for obj in _file_owners(request):
-        label = TEXTURE_SET_NAME if request.options.texture_set else obj.name
-        for _kind, filepath, what, _channels in output_kinds(request):
-            if not filepath:
-                continue
-            for frame in request.frames or [None]:
-                path = output_path_for(request, obj, filepath, frame)
-                at = "" if frame is None else f" at frame {frame}"
-                numbers = (tiles or {}).get(label)
-                out += [(tile, f"{what} of '{label}'{f' tile {t}' if numbers else ''}{at}")
-                        for tile, t in zip(_tile_paths(path, numbers), numbers or [None])]
-    return out + [tuple(entry) for entry in request.extra_outputs]
-
-
-def finished_files(request: BakeRequest, key: str, frame: int | None = None) -> list[str] | None:
-    """The files of the request (of one frame of a sequence) when every one exists and is
-    current: an image carries key as its BAKE_KEY and decodes in full (a map on UDIM tiles:
-    every tile file that exists does, and one at least), another file (glTF, mesh) is whole
-    (output_is_whole). None when
-    anything is missing or was made otherwise: the bake must run."""
-    one = replace(request, frames=None if frame is None else [frame])
-    done = []
-    for path, _what in planned_files(one):
-        if not path or path == "-":
-            continue
-        if os.path.splitext(path)[1].lower() not in FORMATS:
-            if not output_is_whole(path):
-                return None
-            done.append(path)
-            continue
-        files = [path] if os.path.isfile(path) else sorted(glob.glob(_tile_glob(path)))
-        if not files or any(read_text(f, BAKE_KEY) != key or not image_is_whole(f) for f in files):
-            return None
-        done += files
-    return done
-
-
-def _tile_glob(path: str) -> str:
-    """A pattern of the UDIM tile files of path (tile_path with any four-digit number)."""
-    marker = 987654321  # a number no path holds, where the tile's goes
-    return glob.escape(tile_path(path, marker)).replace(str(marker), "[0-9]" * 4)
-
-
-def input_files(request: BakeRequest) -> list[tuple[str, str]]:
-    """The files the run reads, as (path, what): the scene's file, the image files its
-    materials read, and the caller's extra_inputs."""
-    from .images import scene_image_files
-    source = [(request.source_path, "the input file")] if request.source_path else []
-    if bpy.data.filepath:
-        source.append((bpy.data.filepath, "the open .blend file"))
-    return source + scene_image_files() + [tuple(entry) for entry in request.extra_inputs]
-
-
-def _validate_frames(request: BakeRequest) -> None:
-    if not request.frames:
-        raise BakeInputError("a frame sequence needs at least one frame")
-    if request.to_color_attribute:
-        raise BakeInputError("a colour attribute holds one frame: bake a frame sequence into image files")
-    if not request.filepath:
-        raise BakeInputError("a frame sequence writes one file per frame: set Save To (a path with {frame})")
-
-
-def _validate_texture_set(request: BakeRequest) -> None:
-    if request.to_color_attribute or request.high_poly is not None:
-        raise BakeInputError("a texture set bakes the objects' own surfaces into one image: not with a colour "
-                             "attribute or Selected to Active")
-    for obj in request.targets:
-        if obj.type == 'MESH' and not obj.data.uv_layers:
-            raise BakeInputError(f"'{obj.name}' has no UV map: a texture set bakes each object's own UVs into one "
-                                 f"image, so lay out its islands beside the other objects' first")
-    if request.settings.bent_normals and request.options.bent_space == "object":
-        raise BakeInputError("object-space bent normals of a texture set would mix the objects' spaces: use "
-                             "tangent space")
-
-
-def _validate_color_attribute(request: BakeRequest) -> None:
-    if request.high_poly is not None or request.settings.bent_normals:
-        raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active and "
-                             "bent normals bake into images (Target: Image Textures)")
-    if request.filepath or request.image is not None:
-        raise BakeInputError("a colour-attribute bake writes no image: clear the image and the file path, or "
-                             "bake to Image Textures")
-
-
-def _validate_groups(request: BakeRequest) -> None:
-    if request.high_poly is not None or request.cage is not None:
-        raise BakeInputError("bake groups find their high-poly meshes by name: no separate high-poly or cage")
-    if request.to_color_attribute:
-        raise BakeInputError("bake groups bake each low-poly into an image (not a colour attribute)")
-    if request.options.texture_set and (request.settings.bent_normals or request.settings.thickness
-                                        or request.map_path("orm") or request.frames):
-        raise BakeInputError("bake groups in one texture set bake the AO of one frame (not bent normals, thickness, "
-                             "an ORM texture or frames)")
-    if not request.groups:
-        raise BakeInputError(f"no bake group found: no mesh name ends in '{request.options.low_suffix}'")
-    for group in request.groups:
-        for obj in group.highs:
-            if obj.type != 'MESH' or len(obj.data.polygons) == 0:
-                raise BakeInputError(f"high-poly '{obj.name}' of group '{group.name}' is not a mesh with faces")
-
-
-def _validate_high_to_low(request: BakeRequest) -> None:
-    if len(request.targets) != 1 or request.targets[0] is None:
-        raise BakeInputError("Selected to Active bakes onto one low-poly mesh: make it the active object")
-    if not request.high_poly:
-        raise BakeInputError(f"Selected to Active: select the high-poly meshes besides '{request.targets[0].name}'")
-    low = request.targets[0]
-    for obj in request.high_poly:
-        if obj.type != 'MESH':
-            raise BakeInputError(f"high-poly '{obj.name}' is not a mesh")
-        if obj == low or obj == request.cage:
-            raise BakeInputError(f"'{obj.name}' cannot be both the high-poly and the low-poly or cage")
-        if len(obj.data.polygons) == 0:
-            raise BakeInputError(f"high-poly '{obj.name}' has no faces")
-    cage = request.cage
-    if cage is not None and (cage.type != 'MESH' or cage == low):
-        raise BakeInputError(f"the cage '{cage.name}' must be a mesh other than the low-poly")
 
 
 def _with_status(steps: Generator, fraction: float, text: str) -> Generator[tuple[float, str], None, object]:
@@ -522,65 +203,89 @@ class BakeJob:
             texture_set_target([mesh_data.evaluated_soup(u.objects[0], depsgraph, uv_names[u.objects[0].name] or None,
                                                          shading_normals=False) for u in units],
                                req.settings.size, TEXTURE_SET_NAME)
-        at = "" if frame is None else f" at frame {frame}"
         for k, unit in enumerate(units):
-            objects, label = unit.objects, unit.label
-            obj = objects[0]
-            parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
-                                              shading_normals=req.settings.normals == "mesh") for o in objects]
-            soup = texture_set_target(parts, req.settings.size, label) if req.options.texture_set else parts[0]
-            corners = None
-            if req.to_color_attribute:
-                corners = mesh_data.color_attribute_target(obj, depsgraph, req.settings.color_domain)
-            high_to_low = self._high_to_low(obj, depsgraph, unit.sources) if unit.sources is not None else None
-            target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
-            alpha = req.settings.alpha != "off"
-            occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha,
-                                                  alpha_size=req.settings.size) for o in unit.occluders]
-            alpha_notes = sorted({note for o in occluders if o.alpha is not None for note in o.alpha.notes})
-            settings = terminator_settings(req.settings, unit.sources or objects)
-            key = None
-            if frame is not None:
-                key = (label, bake_key(target, occluders, settings))
-                if key in self._frame_bakes:  # the geometry of an earlier frame: its files are copied
-                    earlier, stats, tiles = self._frame_bakes[key]
-                    self._copies[label] = earlier
-                    stub = BakeResult(None, None, None, {**stats, "cache_hit": True}, None, tiles)
-                    self.results.extend((o, uv_names[o.name], stub) for o in objects)
-                    yield start + share * (k + 1) / len(units), f"Reusing frame {earlier} for '{label}'{at}"
-                    continue
-            # A sequence bakes past the shared cache: it would hold up to its size in maps.
-            # (relay closes it on cancel: bake_steps' finally frees the GPU pass now.)
-            result = yield from relay(bake_steps(target, occluders, settings, use_cache=frame is None),
-                                      lambda frac, k=k, label=label, at=at: (
-                                          start + share * (k + frac) / len(units),
-                                          f"Baking AO of '{label}'{at} ({k + 1}/{len(units)}): {frac * 100:.0f}%"))
-            if req.options.verify:
-                check = yield from _with_status(verify_steps(target, occluders, settings, result, req.options.verify),
-                                                start + share * (k + 1) / len(units),
-                                                f"Verifying '{label}'{at} against the reference")
-                if check is not None:
-                    result = replace(result, stats={**result.stats, "verify": check.as_dict()})
-                    self.verifications.append((label, check))
-            if settings.thickness:
-                steps = thickness_steps(soup, settings, use_cache=frame is None)
-                thick = yield from _with_status(steps, start + share * (k + 1) / len(units),
-                                                f"Baking thickness of '{label}'{at}")
-                self.maps["thickness"][label] = thick.ao
-            if req.map_path("orm"):
-                self.maps["orm"][label] = self._orm_image(obj, depsgraph, soup, result)
-            if settings.bent_normals:
-                self.maps["bent"][label] = self._bent_image(objects, depsgraph, [uv_names[o.name] for o in objects],
-                                                           soup, result)
-            if alpha_notes:
-                result = replace(result, stats={**result.stats,
-                                                "warnings": [*result.stats.get("warnings", []), *alpha_notes]})
-            # A texture set's objects share one result (commit writes it once).
-            self.results.extend((o, uv_names[o.name], result) for o in objects)
-            if key is not None:
-                self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
+            span = (start + share * k / len(units), share / len(units))
+            yield from self._bake_unit(unit, uv_names, depsgraph, span, frame, f"({k + 1}/{len(units)})")
         if req.groups is not None and req.options.texture_set:
             self._merge_group_set()
+
+    def _unit_inputs(self, unit: BakeUnit, uv_names: dict, depsgraph) -> tuple:
+        """(the unit's target soup, its BakeTarget, the occluders, their alpha notes, the
+        settings with the objects' terminator) at the scene's current frame."""
+        req = self.request
+        parts = [mesh_data.evaluated_soup(o, depsgraph, uv_names[o.name] or None,
+                                          shading_normals=req.settings.normals == "mesh") for o in unit.objects]
+        soup = texture_set_target(parts, req.settings.size, unit.label) if req.options.texture_set else parts[0]
+        corners = None
+        if req.to_color_attribute:
+            corners = mesh_data.color_attribute_target(unit.objects[0], depsgraph, req.settings.color_domain)
+        high_to_low = self._high_to_low(unit.objects[0], depsgraph, unit.sources) if unit.sources is not None else None
+        target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
+        alpha = req.settings.alpha != "off"
+        occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha,
+                                              alpha_size=req.settings.size) for o in unit.occluders]
+        alpha_notes = sorted({note for o in occluders if o.alpha is not None for note in o.alpha.notes})
+        return soup, target, occluders, alpha_notes, terminator_settings(req.settings, unit.sources or unit.objects)
+
+    def _bake_unit(self, unit: BakeUnit, uv_names: dict, depsgraph, span: tuple[float, float], frame: int | None,
+                   count: str) -> Generator[tuple[float, str], None, None]:
+        """Bake one unit into self.results (and self.maps); progress over span (start, share)."""
+        objects, label = unit.objects, unit.label
+        start, share = span
+        at = "" if frame is None else f" at frame {frame}"
+        soup, target, occluders, alpha_notes, settings = self._unit_inputs(unit, uv_names, depsgraph)
+        key = None
+        if frame is not None:
+            key = (label, bake_key(target, occluders, settings))
+            if key in self._frame_bakes:  # the geometry of an earlier frame: its files are copied
+                earlier, stats, tiles = self._frame_bakes[key]
+                self._copies[label] = earlier
+                stub = BakeResult(None, None, None, {**stats, "cache_hit": True}, None, tiles)
+                self.results.extend((o, uv_names[o.name], stub) for o in objects)
+                yield start + share, f"Reusing frame {earlier} for '{label}'{at}"
+                return
+        # A sequence bakes past the shared cache: it would hold up to its size in maps.
+        # (relay closes it on cancel: bake_steps' finally frees the GPU pass now.)
+        result = yield from relay(bake_steps(target, occluders, settings, use_cache=frame is None),
+                                  lambda frac: (start + share * frac,
+                                                f"Baking AO of '{label}'{at} {count}: {frac * 100:.0f}%"))
+        result = yield from self._verified(result, target, occluders, settings, label, start + share, at)
+        yield from self._make_maps(unit, uv_names, depsgraph, soup, settings, result, start + share, frame)
+        if alpha_notes:
+            result = replace(result, stats={**result.stats,
+                                            "warnings": [*result.stats.get("warnings", []), *alpha_notes]})
+        # A texture set's objects share one result (commit writes it once).
+        self.results.extend((o, uv_names[o.name], result) for o in objects)
+        if key is not None:
+            self._frame_bakes[key] = (frame, dict(result.stats), result.tiles)
+
+    def _verified(self, result: BakeResult, target, occluders: list, settings: BakeSettings, label: str,
+                  fraction: float, at: str) -> Generator[tuple[float, str], None, BakeResult]:
+        """--verify: the result with its check against the reference (self.verifications)."""
+        if not self.request.options.verify:
+            return result
+        check = yield from _with_status(verify_steps(target, occluders, settings, result, self.request.options.verify),
+                                        fraction, f"Verifying '{label}'{at} against the reference")
+        if check is None:
+            return result
+        self.verifications.append((label, check))
+        return replace(result, stats={**result.stats, "verify": check.as_dict()})
+
+    def _make_maps(self, unit: BakeUnit, uv_names: dict, depsgraph, soup, settings: BakeSettings,
+                   result: BakeResult, fraction: float, frame: int | None) -> Generator[tuple[float, str], None, None]:
+        """The maps besides the AO that the request asks for, into self.maps: thickness (a
+        bake of its own), the ORM texture and the bent normals (blender/map_producers.py)."""
+        req, label = self.request, unit.label
+        at = "" if frame is None else f" at frame {frame}"
+        if settings.thickness:
+            steps = thickness_steps(soup, settings, use_cache=frame is None)
+            thick = yield from _with_status(steps, fraction, f"Baking thickness of '{label}'{at}")
+            self.maps["thickness"][label] = thick.ao
+        if req.map_path("orm"):
+            self.maps["orm"][label] = orm_map(req, unit.objects[0], depsgraph, soup, result)
+        if settings.bent_normals:
+            self.maps["bent"][label] = bent_normal_image(req, unit.objects, depsgraph,
+                                                         [uv_names[o.name] for o in unit.objects], soup, result)
 
     def _merge_group_set(self) -> None:
         """Bake groups in one texture set: each low-poly was baked from its own group (a result
@@ -603,44 +308,6 @@ class BakeJob:
         merged = BakeResult(ao, covered, filled, stats, None, first.tiles, twin, error)
         self.own_stats = {obj.name: result.stats for obj, _uv, result in self.results}
         self.results = [(obj, uv, merged) for obj, uv, _r in self.results]
-
-    def _orm_image(self, obj, depsgraph, target: TriangleSoup, result: BakeResult) -> np.ndarray:
-        """(size, size, 4) ORM texture of a finished bake: its AO, the object's roughness and
-        metallic in the baked UV layout (blender/material_channels.py)."""
-        if result.tiles:
-            raise BakeInputError("the ORM texture is a glTF texture, and glTF has no UDIM tiles: these UVs lie on "
-                                 "several; bake without --orm-out")
-        settings = self.request.settings
-        roughness, metallic = roughness_metallic(obj, depsgraph, target.uvs, settings.size, settings.margin)
-        return orm_image(result.ao, roughness, metallic)
-
-    def _bent_image(self, objects: list, depsgraph, uv_names: list[str], target: TriangleSoup,
-                    result: BakeResult):
-        """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
-        texture set's, whose target is their soups in that order), in the request's space."""
-        req = self.request
-        linear = np.array(objects[0].evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
-        tangents = normals = None
-        if req.options.bent_space == "tangent":
-            tangents = np.concatenate([mesh_data.corner_tangents(o, depsgraph, uv)
-                                       for o, uv in zip(objects, uv_names)])
-            # The world corner normals as they are (not re-normalized: on a scaled object that
-            # would turn the decoded direction, 4 degrees on tests/test_bent_normals' sphere).
-            normals = target.normals
-            if normals is None:  # flat shading: every corner has its face's normal
-                normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
-        if result.tiles is None:
-            return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin,
-                                   target.uvs, req.options.bent_space, req.options.bent_convention, linear, tangents, normals)
-        layout = udim_layout(target.uvs)  # one map per tile, from the tile's own triangles
-        maps = []
-        for tile in range(layout.count):
-            faces, local = layout.local_uvs(target.uvs, tile)
-            maps.append(bent_normal_map(result.bent_normals[tile], result.covered[tile], result.filled[tile],
-                                        req.settings.margin, local, req.options.bent_space, req.options.bent_convention, linear,
-                                        None if tangents is None else tangents[faces],
-                                        None if normals is None else normals[faces]))
-        return np.stack(maps)
 
     def run(self) -> None:
         for _ in self.steps():
@@ -709,10 +376,10 @@ class BakeJob:
                     path = output_path_for(req, obj, filepath, frame)
                     if not path:
                         continue
-                    paths = _tile_paths(path, result.tiles)
+                    paths = tile_paths(path, result.tiles)
                     if label in self._copies:  # a repeated frame: the earlier frame's files, byte for byte
                         earlier = output_path_for(req, obj, filepath, self._copies[label])
-                        for file_path, source in zip(paths, _tile_paths(earlier, result.tiles)):
+                        for file_path, source in zip(paths, tile_paths(earlier, result.tiles)):
                             staged.write_bytes(file_path, Path(source).read_bytes())
                     else:
                         maps = self._map_of(kind, label, result)

@@ -216,7 +216,7 @@ def _pick_groups(args, run: _Run, report: Report) -> list:
 
 def _request(args, run: _Run, targets: list, high_poly: list | None, cage, groups: list | None = None):
     """The job's BakeRequest: what to bake, and every file the run reads and writes."""
-    from ..blender.bake_job import BakeRequest
+    from ..blender.bake_request import BakeRequest
     from ..core.imageio import BAKE_KEY
 
     return BakeRequest(targets=targets, settings=run.settings, options=run.options, frames=run.frames,
@@ -258,7 +258,7 @@ def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Pro
 
 def _report_results(job, run: _Run, args, report: Report, seconds: float) -> list[str]:
     """The report's objects, outputs and warnings of a finished job; returns its summary lines."""
-    from ..blender.bake_job import output_path_for
+    from ..blender.bake_request import output_path_for
     from ..blender.color_attributes import AO_ATTRIBUTE
     from ..blender.paths import frame_pattern
 

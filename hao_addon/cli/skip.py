@@ -54,7 +54,7 @@ def skip_finished(request, key: str, report) -> tuple[object | None, list[str]]:
     skipped). The skipped
     files are listed in report.outputs and report.skipped; a sequence's skipped frames in
     report.frames (with skipped: true)."""
-    from ..blender.bake_job import finished_files
+    from ..blender.bake_request import finished_files
     from .io import REPORT
     # The report is written by every run, finished or not: not a file the bake must find.
     wanted = replace(request, extra_outputs=[entry for entry in request.extra_outputs if entry[1] != REPORT])

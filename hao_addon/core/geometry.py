@@ -201,21 +201,20 @@ def surface_holes(positions: np.ndarray, welded: tuple[np.ndarray, np.ndarray] |
     slot = np.minimum(np.searchsorted(reversed_sorted, order), len(order) - 1)
     border = order[reversed_sorted[slot] != order]
     start, end = border // n, border % n
-    if len(np.unique(start)) != len(start) or len(np.unique(end)) != len(end):
-        return None  # a border vertex with two loops through it
-    successor = dict(zip(start.tolist(), end.tolist()))
-    loops, seen = [], set()
-    for first in successor:
-        if first in seen:
-            continue
-        loop, v = [], first
-        while v not in seen:
-            seen.add(v)
-            loop.append(v)
-            v = successor.get(v, -1)
-            if v < 0:
-                return None
-        loops.append(np.array(loop))
+    loops = _border_loops(start, end)
+    if loops is None:
+        return None
+    if not _capped_parts_enclose_volume(verts, tri, loops, start, end):
+        return None
+    return [verts[loop] for loop in loops]
+
+
+def _capped_parts_enclose_volume(verts: np.ndarray, tri: np.ndarray, loops: list[np.ndarray], start: np.ndarray,
+                                 end: np.ndarray) -> bool:
+    """Whether every connected part of the welded triangles (verts (V, 3), tri (F, 3)), each
+    border loop capped by a fan to its centroid (border edges start -> end), encloses a
+    positive volume."""
+    n = len(verts)
     # Signed volume of each connected part plus its caps (divergence theorem, corners relative
     # to the mean so large offsets do not cancel digits). Every part must enclose a positive
     # volume: one inside-out part (or a sheet, which capped by itself encloses nothing) among
@@ -236,9 +235,28 @@ def surface_holes(positions: np.ndarray, welded: tuple[np.ndarray, np.ndarray] |
     volume = np.bincount(owner, weights=det, minlength=n)
     size = np.bincount(owner, weights=np.abs(det), minlength=n)
     used = np.unique(owner)
-    if not (volume[used] > 1e-6 * size[used]).all():
-        return None
-    return [verts[loop] for loop in loops]
+    return bool((volume[used] > 1e-6 * size[used]).all())
+
+
+def _border_loops(start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
+    """The closed loops of border edges start[i] -> end[i] (welded vertex numbers), each as
+    its vertices in order; None where a vertex has two loops through it or a walk breaks off."""
+    if len(np.unique(start)) != len(start) or len(np.unique(end)) != len(end):
+        return None  # a border vertex with two loops through it
+    successor = dict(zip(start.tolist(), end.tolist()))
+    loops, seen = [], set()
+    for first in successor:
+        if first in seen:
+            continue
+        loop, v = [], first
+        while v not in seen:
+            seen.add(v)
+            loop.append(v)
+            v = successor.get(v, -1)
+            if v < 0:
+                return None
+        loops.append(np.array(loop))
+    return loops
 
 
 def component_labels(tri: np.ndarray, vertex_count: int) -> np.ndarray:

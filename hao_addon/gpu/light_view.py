@@ -186,9 +186,9 @@ def plan_batch(plan: BakePlan, with_occluders: bool, order: np.ndarray | None = 
     order: (F,) face permutation of that list to draw in, or None; face_bins: (F,) target
     face normal bins, added as the float attribute "bin" with the face normal as
     "geometric", each corner's face corners and barycentric unit vector
-    (bake_gather.FACE_ATTRIBUTES; target alone only); lift_corners: with them, each corner also
+    (gather_shaders.FACE_ATTRIBUTES; target alone only); lift_corners: with them, each corner also
     carries its face's shading normals (the texel list's terminator lift,
-    bake_gather.LIFT_ATTRIBUTES)."""
+    gather_shaders.LIFT_ATTRIBUTES)."""
     # Selected to Active: the target is not drawn with the occluders (plan.target_drawn).
     ft = len(plan.target_positions) if plan.target_drawn or not with_occluders else 0
     fo = len(plan.occluder_positions) if with_occluders else 0

@@ -29,20 +29,9 @@ from .udim import UdimLayout, udim_layout
 from .target_kinds import TARGET_KINDS, TargetKind
 from .targets import BakeTarget, as_bake_target
 from .vertex_target import VertexTarget
+from .view_size import DENSE_AREA_LIMIT, light_pixel_size
 from .views import OrthoView, cell_corners, fit_views
 
-# The light view never exceeds this many pixels per side (GPU limit is checked separately);
-# at 8192^2 one RGBA32F view buffer takes 1 GiB.
-MAX_VIEW_SIDE = 8192
-# Light-view pixels are sized so that this fraction of the surface area (the part with the
-# densest UVs) may get fewer than `view_samples` pixels per texel; the footprint-aware splat
-# keeps those texels hole-free, only their visibility is sampled more coarsely.
-DENSITY_PERCENTILE = 0.10
-# Texels smaller than a light-view pixel by this factor (per side) leave holes between the
-# tent splats of neighbouring pixels; when more than DENSE_AREA_LIMIT of the texels are like
-# that, the bake uses the footprint-splitting shader variant (slower, so only then).
-FOOTPRINT_SPLIT = 1.5
-DENSE_AREA_LIMIT = 0.005
 # Selected-to-Active light views are fitted to the corners of grid cells this many light-view
 # pixels wide that hold receivers (views.cell_corners): a few thousand points instead of
 # millions, for windows at most that much wider.
@@ -267,33 +256,14 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     an earlier plan's (BakePlan.projection) of the same target, sources and settings but for
     directions and seed, used instead of casting again. cells: BakePlan.cells."""
     settings = settings.validated()
-    bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
-    bake_target.check(settings.bent_normals)
+    bake_target, occluders = _checked_inputs(target, occluders, settings, high_to_low, vertex_target)
     kind, target = bake_target.kind, bake_target.soup
     high_to_low, vertex_target = bake_target.high_to_low, bake_target.corners
-    _check_finite(target)
-    for occ in occluders:
-        _check_finite(occ)
-    if high_to_low is not None:
-        check_high_to_low(target, high_to_low, settings.cage_extrusion)
-        occluders = [*high_to_low.sources, *occluders]
-
     normals, areas = face_normals_areas(target.positions)
     if not (areas > 0.0).any():
         raise BakeInputError(f"'{target.name}' has only zero-area faces")
-    udim = None
-    if kind.needs_uvs:
-        uv_area = uv_areas(target.uvs)
-        if not (uv_area > 0.0).any():
-            raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
-        udim = udim_layout(target.uvs)
-        uv_warnings, uv_counters = _layout_warnings(target, settings.size, udim)
-    else:  # no UV layout: the light views are as fine as for a Size map over the bounding sphere
-        uv_area, uv_warnings, uv_counters = None, [], {}
-    # A method that cannot bake what is asked is refused before the projection's rays.
-    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
-                             settings.min_distance, settings.spread_cos > 0.0)
-    check_method(choose_method(settings.method, needs), needs, asked_phrases(udim))
+    uv_area, udim, uv_warnings, uv_counters = _uv_layout(target, kind, settings)
+    needs = _checked_method(settings, kind, udim)  # before the projection's rays
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
@@ -303,8 +273,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     directions = bake_directions(settings.directions, settings.seed)
 
     # Selected to Active: the receivers are the sources' points the texels project to.
-    projected, projection_stats = None, {}
-    extent = 1.0  # radius of the receivers' sphere about the origin, normalized
+    projected, projection_stats, extent = None, {}, 1.0  # extent: the receivers' sphere's radius, normalized
     if high_to_low is not None:
         if projection is None:
             projection = yield from projected_receivers_steps(target, high_to_low, settings, centre, scale, cast, udim)
@@ -313,8 +282,92 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         if len(projected):
             extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))
             flat = np.concatenate([flat, projected.points * scale + centre])
+    o_pos, alpha_parts, culling = _drawn_occluders(occluders, flat, settings, kind, target, centre, scale)
+    o_normals, _ = face_normals_areas(o_pos)
+    inv_s = _inverse_normalizers(normals, areas, directions, settings)
+    corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
+    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, needs, extent)
 
-    # Occluders that cannot reach the receivers within max_distance are never drawn.
+    drawn = np.concatenate(([t_pos.reshape(-1, 3)] if kind.target_occludes else []) + [o_pos.reshape(-1, 3)])
+    target_weld = weld(t_pos.reshape(-1, 3))
+    alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
+    holes = _drawn_holes(settings, alpha, drawn, target_weld if len(o_pos) == 0 else None)
+    # Distinct corners: a light view's window is fitted to them (shared corners once); in
+    # Selected to Active the corners of the grid cells that hold receivers (VIEW_FIT_CELL).
+    target_points = t_pos.reshape(-1, 3)[target_weld[0]] if projected is None else \
+        cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
+    stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
+                        holes, smooth_corners, uv_warnings, alpha,
+                        {**uv_counters, **_layout_counters(udim, vertex_target), **projection_stats})
+    uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
+    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), uvs.astype(np.float32),
+                    np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
+                    o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
+                    pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, bounding_sphere(drawn),
+                    dense_fraction > DENSE_AREA_LIMIT,
+                    smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
+                    holes == [], holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells)
+
+
+def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> frozenset:
+    """What the bake needs of a baker; a method that cannot bake it is refused here."""
+    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
+                             settings.min_distance, settings.spread_cos > 0.0)
+    check_method(choose_method(settings.method, needs), needs, asked_phrases(udim))
+    return needs
+
+
+def _inverse_normalizers(normals: np.ndarray, areas: np.ndarray, directions: np.ndarray,
+                         settings: BakeSettings) -> np.ndarray:
+    """(F,) 1 / S_f of each face (face_normalizers); faces no direction sees, and zero-area
+    faces (no surface), contribute nothing: 0."""
+    s_f = face_normalizers(normals, directions, settings.weighting, spread_cos=settings.spread_cos)
+    return np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
+
+
+def _drawn_holes(settings: BakeSettings, alpha, drawn: np.ndarray, welded) -> list | None:
+    """surface_holes of what the light views draw, where it can change what is drawn (see
+    depth_map_culls_back_faces); None where it cannot. welded: the drawn corners' weld when
+    they are the target's alone (one weld serves both)."""
+    # Through surfaces that let light through, every face on a ray counts: no culling of one side.
+    if settings.max_distance != 0.0 or settings.min_distance != 0.0 or settings.ignore_back_faces \
+            or alpha is not None:
+        return None
+    return surface_holes(drawn.reshape(-1, 3, 3), welded)
+
+
+def _checked_inputs(target, occluders: list[TriangleSoup], settings: BakeSettings, high_to_low: HighToLow | None,
+                    vertex_target: VertexTarget | None) -> tuple[BakeTarget, list[TriangleSoup]]:
+    """The bake target (checked for what the settings ask) and the occluders (Selected to
+    Active: the high-poly sources first), every one of them finite."""
+    bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
+    bake_target.check(settings.bent_normals)
+    _check_finite(bake_target.soup)
+    for occ in occluders:
+        _check_finite(occ)
+    if bake_target.high_to_low is not None:
+        check_high_to_low(bake_target.soup, bake_target.high_to_low, settings.cage_extrusion)
+        occluders = [*bake_target.high_to_low.sources, *occluders]
+    return bake_target, occluders
+
+
+def _uv_layout(target: TriangleSoup, kind, settings: BakeSettings) -> tuple:
+    """(each face's UV area, the UDIM layout, the layout's warnings and counters), or
+    (None, None, [], {}) for a target without a UV layout."""
+    if not kind.needs_uvs:  # the light views are as fine as for a Size map over the bounding sphere
+        return None, None, [], {}
+    uv_area = uv_areas(target.uvs)
+    if not (uv_area > 0.0).any():
+        raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
+    udim = udim_layout(target.uvs)
+    return (uv_area, udim, *_layout_warnings(target, settings.size, udim))
+
+
+def _drawn_occluders(occluders: list[TriangleSoup], flat: np.ndarray, settings: BakeSettings, kind,
+                     target: TriangleSoup, centre: np.ndarray, scale: float) -> tuple:
+    """(the occluders' drawn faces, normalized (N, 3, 3); (faces, alpha) of every drawn part
+    in order, the target's first where it occludes; culling counters). Occluders that cannot
+    reach the receivers (flat: their points) within max_distance are never drawn."""
     if settings.max_distance > 0.0 and occluders:
         lo_t, hi_t = column_bounds(flat)
     occ_parts, culled_objects, culled_faces, drawn_objects = [], 0, 0, 0
@@ -337,69 +390,35 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         occ_parts.append((p - centre) / scale)
         alpha_parts.append((len(p), occ.alpha if occ.alpha is None or near is None else occ.alpha.subset(near)))
     o_pos = np.concatenate(occ_parts) if occ_parts else np.zeros((0, 3, 3))
-    o_normals, _ = face_normals_areas(o_pos)
+    culling = dict(occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
+                   occluder_objects_culled=culled_objects)
+    return o_pos, alpha_parts, culling
 
-    s_f = face_normalizers(normals, directions, settings.weighting, spread_cos=settings.spread_cos)
-    # Faces no direction sees, and zero-area faces (no surface), contribute nothing.
-    inv_s = np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
-    corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
 
-    if udim is not None:  # each tile as fine as its own bake would be: the finest of them
-        tiles = [faces for faces in map(udim.faces, range(udim.count))
-                 if ((areas[faces] > 0.0) & (uv_area[faces] > 0.0)).any()]  # a tile of zero-area faces asks nothing
-        pixel_size = min(_uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
-        dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
-    elif kind.needs_uvs:
-        method = choose_method(settings.method, needs)
-        pixel_size, dense_fraction = _uv_pixel_size(settings, areas, uv_area, scale, method)
-    else:  # Size pixels across the bounding sphere's diameter (2), times sqrt(view samples)
-        pixel_size, dense_fraction = 2.0 / (settings.size * float(np.sqrt(settings.view_samples))), 0.0
-    # The receivers' sphere has diameter 2 (the target's), or 2 extent in Selected to Active.
-    pixel_size = max(pixel_size, 2.0 * extent / (MAX_VIEW_SIDE - 4))
-
-    drawn_parts = [o_pos.reshape(-1, 3)]
-    if kind.target_occludes:
-        drawn_parts.insert(0, t_pos.reshape(-1, 3))
-    drawn = np.concatenate(drawn_parts)
-    target_weld = weld(t_pos.reshape(-1, 3))
-    # Only worth knowing where it can change what is drawn (see depth_map_culls_back_faces).
-    alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
-    holes = None
-    # Through surfaces that let light through, every face on a ray counts: no culling of one side.
-    if settings.max_distance == 0.0 and settings.min_distance == 0.0 and not settings.ignore_back_faces \
-            and alpha is None:
-        # Without occluders the drawn corners are the target's: one weld serves both.
-        holes = surface_holes(drawn.reshape(-1, 3, 3), target_weld if len(o_pos) == 0 else None)
-    closed = holes == []
-    drawn_sphere = bounding_sphere(drawn)
-    # Distinct corners: a light view's window is fitted to them (shared corners once); in
-    # Selected to Active the corners of the grid cells that hold receivers (VIEW_FIT_CELL).
-    target_points = t_pos.reshape(-1, 3)[target_weld[0]]
-    if projected is not None:
-        target_points = cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
-
+def _layout_counters(udim: UdimLayout | None, vertex_target: VertexTarget | None) -> dict:
+    counters = {}
     if udim is not None:
-        uv_counters = {**uv_counters, "udim_tiles": [int(t) for t in udim.tiles]}
+        counters["udim_tiles"] = [int(t) for t in udim.tiles]
     if vertex_target is not None:
-        uv_counters = {**uv_counters, "vertex_target_corners": int((vertex_target.cells >= 0).sum()),
-                       "vertex_target_elements": vertex_target.count}
-    stats = dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
-                 zero_uv_area_faces=0 if uv_area is None else int((uv_area <= 0.0).sum()), occluder_faces_drawn=int(len(o_pos)),
-                 occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
-                 occluder_objects_culled=culled_objects, pixel_size_world=pixel_size * scale,
-                 dense_uv_area_fraction=dense_fraction, closed_surfaces=closed,
-                 holes=-1 if holes is None else len(holes), smooth_corners=smooth_corners,
-                 samples_per_texel=settings.sample_count, warnings=uv_warnings,
-                 alpha_faces=0 if alpha is None else int(((alpha.constant < 1.0) | (alpha.layer >= 0)).sum()),
-                 **uv_counters, **projection_stats)
-    uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
-    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), uvs.astype(np.float32),
-                    np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
-                    o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
-                    pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, drawn_sphere,
-                    dense_fraction > DENSE_AREA_LIMIT,
-                    smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    closed, holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells)
+        counters.update(vertex_target_corners=int((vertex_target.cells >= 0).sum()),
+                        vertex_target_elements=vertex_target.count)
+    return counters
+
+
+def _plan_stats(target: TriangleSoup, settings: BakeSettings, areas: np.ndarray, uv_area: np.ndarray | None,
+                occluder_faces: int, culling: dict, pixel_size_world: float, dense_fraction: float, holes,
+                smooth_corners: int, warnings: list[str], alpha, counters: dict) -> dict:
+    """The plan's counters (BakeResult.stats: what was drawn, culled, skipped)."""
+    return dict(target_faces=int(target.face_count), zero_area_faces=int((areas <= 0.0).sum()),
+                zero_uv_area_faces=0 if uv_area is None else int((uv_area <= 0.0).sum()),
+                occluder_faces_drawn=int(occluder_faces), occluder_faces_culled=culling["occluder_faces_culled"],
+                occluder_objects_drawn=culling["occluder_objects_drawn"],
+                occluder_objects_culled=culling["occluder_objects_culled"], pixel_size_world=pixel_size_world,
+                dense_uv_area_fraction=dense_fraction, closed_surfaces=holes == [],
+                holes=-1 if holes is None else len(holes), smooth_corners=smooth_corners,
+                samples_per_texel=settings.sample_count, warnings=warnings,
+                alpha_faces=0 if alpha is None else int(((alpha.constant < 1.0) | (alpha.layer >= 0)).sum()),
+                **counters)
 
 
 def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:
@@ -420,30 +439,6 @@ def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -
             else:
                 counters[key] = counters.get(key, 0) + value
     return warnings, counters
-
-
-def _uv_pixel_size(settings: BakeSettings, areas: np.ndarray, uv_area: np.ndarray, scale: float,
-                   method: str) -> tuple[float, float]:
-    """(light-view pixel side, normalized; the fraction of the UV area whose texels are
-    FOOTPRINT_SPLIT times smaller than a pixel per side) from the texel density: the world
-    area per texel on each face. method: the bake variant that runs (the scatter samples
-    finer where it anti-aliases)."""
-    size = settings.size
-    useful = (areas > 0.0) & (uv_area > 0.0)
-    texel_world_area = (areas[useful] / scale**2) / (uv_area[useful] * size * size)
-    order = np.argsort(texel_world_area)
-    cum = np.cumsum(areas[useful][order])
-    # The 10th area-percentile face density: 90 % of the surface gets at least
-    # view_samples pixels per texel; finer texels elsewhere are averaged by the tent splat.
-    density = texel_world_area[order][np.searchsorted(cum, DENSITY_PERCENTILE * cum[-1])]
-    # The scatter's anti-aliasing: that many times more light-view pixels per texel.
-    scatter = method == "scatter"
-    scatter_samples = settings.view_samples * (settings.sample_count if scatter else 1)
-    pixel_size = float(np.sqrt(density / scatter_samples))
-    # UV area, not surface area: a small dense region can hold many texels.
-    texel_side = np.sqrt(texel_world_area)
-    uv_used = uv_area[useful]
-    return pixel_size, float(uv_used[texel_side * FOOTPRINT_SPLIT < pixel_size].sum() / uv_used.sum())
 
 
 def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,
