@@ -34,7 +34,7 @@ from ..core.bake.unwrap import check_unwrap_overlap, unwrap_steps
 from . import color_attributes, images, mesh_data
 from .bake_request import (TEXTURE_SET_NAME, BakeGroup, BakeRequest, input_files, output_kinds, output_path_for,
                            planned_files, terminator_settings, tile_paths, validate_request)
-from .map_producers import bent_normal_image, orm_map
+from .map_producers import bent_normal_image, orm_map, surface_maps
 from .view_scene import BAKED_AO_PROPERTY
 
 @dataclass
@@ -65,7 +65,7 @@ class BakeJob:
         self.results: list[tuple[bpy.types.Object, str, BakeResult]] = []
         # The maps made beside each result (bent normals (size, size, 4) encoded, thickness
         # (size, size), the ORM texture (size, size, 4)): map key -> label -> map.
-        self.maps: dict[str, dict[str, np.ndarray]] = {"bent": {}, "thickness": {}, "orm": {}}
+        self.maps: dict[str, dict[str, np.ndarray]] = {kind.key: {} for kind in EXTRA_MAPS}
         self.own_stats: dict[str, dict] = {}  # bake groups in a texture set: each low-poly's own bake's stats
         # --verify: (label, Verification) of each verified bake (hao_addon/verify.py).
         self.verifications: list[tuple[str, object]] = []
@@ -286,6 +286,8 @@ class BakeJob:
         if settings.bent_normals:
             self.maps["bent"][label] = bent_normal_image(req, unit.objects, depsgraph,
                                                          [uv_names[o.name] for o in unit.objects], soup, result)
+        for key, made in surface_maps(req, soup, result.tiles).items():  # curvature, cavity
+            self.maps[key][label] = made
 
     def _merge_group_set(self) -> None:
         """Bake groups in one texture set: each low-poly was baked from its own group (a result

@@ -174,6 +174,9 @@ def validate_request(request: BakeRequest) -> None:
     if request.map_path("orm") and (request.to_color_attribute or request.options.texture_set):
         raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
                              "texture set)")
+    surface_maps = [kind for kind in EXTRA_MAPS if kind.from_surface is not None and request.map_path(kind.key)]
+    if surface_maps and request.to_color_attribute:
+        raise BakeInputError(f"{surface_maps[0].noun} is an image of the UV layout, not a colour attribute")
     if request.map_path("error") and request.to_color_attribute:
         raise BakeInputError("an error map is an image of the UV layout: a colour-attribute bake reports its error "
                              "(--json) but has no error map")

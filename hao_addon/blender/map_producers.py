@@ -1,12 +1,14 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The producers of the maps a bake job makes beside its AO result (core/bake/map_kinds.py):
 the bent normals in the request's space and convention, and glTF's ORM texture from the
-objects' materials. (Thickness is a bake of its own: bake.thickness_steps.)"""
+objects' materials, and those made from the surface alone (curvature, cavity). (Thickness is a
+bake of its own: bake.thickness_steps.)"""
 from __future__ import annotations
 
 import numpy as np
 
 from ..bake import BakeResult
+from ..core.bake.map_kinds import EXTRA_MAPS
 from ..core.bake.orm import orm_image
 from ..core.bake.tangent_space import bent_normal_map
 from ..core.bake.udim import udim_layout
@@ -54,3 +56,17 @@ def bent_normal_image(request: BakeRequest, objects: list, depsgraph, uv_names: 
                                     None if tangents is None else tangents[faces],
                                     None if normals is None else normals[faces]))
     return np.stack(maps)
+
+
+def surface_maps(request: BakeRequest, target: TriangleSoup, tiles: tuple[int, ...] | None) -> dict[str, np.ndarray]:
+    """The maps made from the target's surface alone (core/bake/map_kinds.py: from_surface,
+    such as curvature and cavity) that the request writes, by key."""
+    made = {}
+    for kind in EXTRA_MAPS:
+        if kind.from_surface is None or not request.map_path(kind.key):
+            continue
+        if tiles:
+            raise BakeInputError(f"{kind.noun} is made on one 0..1 tile, and these UVs lie on several UDIM tiles: "
+                                 f"bake without {kind.flag}")
+        made[kind.key] = kind.from_surface(target, request.settings.size, request.settings.margin)
+    return made

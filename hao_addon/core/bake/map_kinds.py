@@ -5,6 +5,11 @@ manual's table are made from. A new map is a new row (and its producer in the ba
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .curvature import cavity_map, curvature_map
 
 
 @dataclass(frozen=True)
@@ -22,6 +27,9 @@ class MapKind:
     note: str = ""  # what else its file option does (the CLI's help)
     image_suffix: str = ""  # the Blender image it is stored in: '<object>_<suffix>' ('' none: a file only)
     settings: tuple[str, ...] = ()  # the settings that shape it alone (the panel draws them with it)
+    # Made from the target's own surface alone: (soup, size, margin) -> (size, size) map (no AO
+    # result needed; the bake job calls it for each target). None: the job's own producer.
+    from_surface: Callable[..., np.ndarray] | None = None
 
     @property
     def option(self) -> str:
@@ -61,6 +69,12 @@ MAP_KINDS = (
     MapKind("error", "error", "the error map", 1, "", "error_file", "Save Error To",
             "each texel's estimated error (the RMS of the bake's own error estimate over its 5 x 5 "
             "neighbourhood: one standard error)"),
+    MapKind("curvature", "curvature", "the curvature map", 1, "", "curvature_file", "Save Curvature To",
+            "the surface's mean curvature times its bounding radius, 0.5 flat, brighter convex, darker concave",
+            image_suffix="Curvature", from_surface=curvature_map),
+    MapKind("cavity", "cavity", "the cavity map", 1, "", "cavity_file", "Save Cavity To",
+            "cavities: 1 on flat and convex surface, darker in grooves and crevices", image_suffix="Cavity",
+            from_surface=cavity_map),
 )
 # The maps besides the AO, each with a file option of its own.
 EXTRA_MAPS = MAP_KINDS[1:]
