@@ -5,22 +5,8 @@ from __future__ import annotations
 import bpy
 
 from ..core.errors import BakeInputError
-from ..core.output_files import FRAME_DIGITS, FRAME_TOKEN, OBJECT_TOKEN  # noqa: F401 - this module's names too
-from ..core.output_files import input_file_name  # noqa: F401 - this module's name too
-
-
-def example_path(path: str, frame: int = 0) -> str:
-    """The path with every token filled by an example value ('{object}' -> 'object', <UDIM> ->
-    1001, '{frame}' -> the frame given, zero-padded: the sequence's first), for checking
-    before a bake that such a file can be written."""
-    from ..core.bake.udim import FIRST_TILE, UDIM_TOKEN
-    return (path.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, str(FIRST_TILE))
-            .replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}"))
-
-
-def frame_pattern(path: str) -> str:
-    """A sequence's path as Blender shows one: '{frame}' as '####' (FRAME_DIGITS of them)."""
-    return path.replace(FRAME_TOKEN, "#" * FRAME_DIGITS)
+# The path helpers without Blender (tokens, example paths, frame patterns) are core/output_files.py's.
+from ..core.output_files import FRAME_TOKEN, OBJECT_TOKEN, example_path, frame_pattern  # noqa: F401 - re-exported
 
 
 def absolute_path(path: str) -> str:

@@ -78,7 +78,7 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
 
 def _checked_run(args, report: Report) -> _Run:
     """The settings, and every file the run reads and writes, checked before a long load."""
-    from ..blender.paths import example_path
+    from ..core.output_files import example_path
     from ..core.imageio import check_writable
 
     settings, options, frames = checked_options(args)
@@ -260,7 +260,7 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
     """The report's objects, outputs and warnings of a finished job; returns its summary lines."""
     from ..blender.bake_request import output_path_for
     from ..blender.color_attributes import AO_ATTRIBUTE
-    from ..blender.paths import frame_pattern
+    from ..core.output_files import frame_pattern
 
     request, settings = job.request, run.settings
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)

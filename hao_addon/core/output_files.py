@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 from typing import Iterable
 
+from .bake.udim import FIRST_TILE, UDIM_TOKEN
 from .errors import BakeInputError
 
 # The tokens of output paths, filled per file: the baked object's (or texture set's) name, the
@@ -49,6 +50,19 @@ class OutputCollision(BakeInputError):
     def __init__(self, message: str, parties: tuple[str, str]) -> None:
         super().__init__(message)
         self.parties = parties
+
+
+def example_path(path: str, frame: int = 0) -> str:
+    """The path with every token filled by an example value ('{object}' -> 'object', <UDIM> ->
+    1001, '{frame}' -> the frame given, zero-padded: the sequence's first), for checking
+    before a bake that such a file can be written."""
+    return (path.replace(OBJECT_TOKEN, "object").replace(UDIM_TOKEN, str(FIRST_TILE))
+            .replace(FRAME_TOKEN, f"{frame:0{FRAME_DIGITS}d}"))
+
+
+def frame_pattern(path: str) -> str:
+    """A sequence's path as Blender shows one: '{frame}' as '####' (FRAME_DIGITS of them)."""
+    return path.replace(FRAME_TOKEN, "#" * FRAME_DIGITS)
 
 
 def with_token(path: str, token: str) -> str:
