@@ -56,6 +56,8 @@ class BakeResult:
     # the map's estimate from them; None with a single direction.
     twin: np.ndarray | None = None
     error: ErrorEstimate | None = None
+    # The bake method that ran (the plan's choice, BakePlan.method; stats["method"] reports it).
+    method: str = ""
 
     def error_map(self) -> np.ndarray | None:
         """ao's shape float32: each texel's estimated error (its neighbourhood's RMS twin)."""
@@ -227,17 +229,15 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     bakes there (BakePlan.cells)."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     projects = target.high_to_low is not None
-    method = settings.method_for(projects)
     share = PROJECTION_PROGRESS_SHARE if projects else 0.0
-    # The method's own ray cast (an unknown method is refused by the plan's validation).
-    cast = ray_caster_for(method) if projects and method in BAKE_METHODS else None
-    cast_stats = {"ray_cast": ray_cast_name(method)} if cast is not None else {}
     shared = {} if shared is None else shared
-    planning = make_plan_steps(target, occluders, settings, cast=cast, projection=shared.get("projection"),
-                               cells=shared.get("cells"))
+    # The plan chooses the method (BakePlan.method), and the projection casts with its own rays.
+    planning = make_plan_steps(target, occluders, settings, projection=shared.get("projection"),
+                               cells=shared.get("cells"), cast_for=ray_caster_for)
     plan = yield from relay(planning, lambda fraction: share * fraction)  # a cancel stops the projection
     shared["projection"] = plan.projection
-    method = choose_method(settings.method, plan.abilities_needed)
+    method = plan.method
+    cast_stats = {"ray_cast": ray_cast_name(method)} if projects and method in BAKE_METHODS else {}
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
@@ -275,7 +275,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "cache_hit": False, "error": None if error is None else error.as_dict()}
     tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
-    return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error)
+    return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error, method)
 
 
 def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, shared: dict
@@ -304,7 +304,7 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             shown = max(shown, min(0.99, (done + fraction * size) / max(done + size, 1)))
             return shown
         part = yield from relay(_bake_uncached(target, occluders, round_settings, shared), overall)
-        skips = not declaration(part.stats["method"]).bakes_all_cells
+        skips = not declaration(part.method).bakes_all_cells
         rounds.append((size, part))
         done += size
         combined = _combine_rounds(rounds, settings.margin)
@@ -326,7 +326,7 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             skipped += size * float(combined.covered.sum() - active.sum())
     skipping = {"rounds": [n for n, _r in rounds], "skippable_fraction": skipped / work if work else 0.0,
                 "skipped_converged": SKIP_CONVERGED and skips and skipped > 0.0,
-                **({"bakes_all_cells": declaration(rounds[0][1].stats["method"]).bakes_all_cells} if not skips else {})}
+                **({"bakes_all_cells": declaration(rounds[0][1].method).bakes_all_cells} if not skips else {})}
     return _to_error_result(combined, settings, stat_target, done, skipping, target.name)
 
 
@@ -357,7 +357,7 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
     puts a bake to an error above its target."""
     if result.error is None or result.twin is None:
         return result
-    ran = declaration(result.stats["method"])
+    ran = declaration(result.method)
     if ran.gpu and ran.floor_unchecked:  # said, so the twins' part is not read as the whole error
         error = replace(result.error, floor_unmeasured=ran.floor_unchecked)
         return replace(result, error=error, stats={**result.stats, "error": error.as_dict()})
@@ -413,7 +413,7 @@ def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeRe
     error = None if twin is None else estimate(twin, covered, total)
     stats = {**last.stats, **{k: first.stats[k] for k in ("covered_texels", "warnings") if k in first.stats},
              "directions": total, "error": None if error is None else error.as_dict()}
-    return BakeResult(ao, covered, first.filled, stats, bent, first.tiles, twin, error)
+    return BakeResult(ao, covered, first.filled, stats, bent, first.tiles, twin, error, first.method)
 
 
 def _regrown(values: np.ndarray, covered: np.ndarray, first: BakeResult, margin: int) -> np.ndarray:
@@ -459,7 +459,8 @@ def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: boo
     result = yield from bake_steps(inverted(replace(target, normals=None)), [], inside, use_cache)
     stats = {**result.stats, "thickness_distance": distance}
     twin = None if result.twin is None else -result.twin  # 1 - ao errs by minus ao's error
-    return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles, twin, result.error)
+    return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles, twin, result.error,
+                      result.method)
 
 
 def bake(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,

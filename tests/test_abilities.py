@@ -124,3 +124,22 @@ def test_each_baker_class_is_its_declared_method(gpu_context):
     from hao_addon.bakers import baker_for
     for method in BAKE_METHODS:
         assert baker_for(method).METHOD == method
+
+
+def test_the_plan_chooses_the_method_once_and_the_result_carries_it(gpu_context, monkeypatch):
+    """One place chooses the method (the plan: BakePlan.method); the bake runs that baker and
+    the result carries it as a value (BakeResult.method), with no second choice after the plan."""
+    from hao_addon import bake as bake_module
+    from hao_addon.core.bake import plan as plan_module
+
+    sphere = scenes.uv_sphere(1.0, (0.0, 0.0, 0.0), 16, 8)
+    for settings, method in ((BakeSettings(size=32, directions=8, max_distance=0.5), "scatter"),
+                             (BakeSettings(size=32, directions=8), "gather")):
+        assert make_plan(sphere, [], settings).method == method
+    calls = []
+    real = plan_module.choose_method
+    monkeypatch.setattr(plan_module, "choose_method", lambda *a: calls.append(a) or real(*a))
+    monkeypatch.setattr(bake_module, "choose_method", lambda *a: pytest.fail("chosen again after the plan"),
+                        raising=False)
+    result = bake_module.bake(sphere, [], BakeSettings(size=32, directions=8, max_distance=0.5), use_cache=False)
+    assert result.method == result.stats["method"] == "scatter" and len(calls) == 1

@@ -307,7 +307,7 @@ class BakeJob:
         error = None if twin is None else estimate(twin, covered, max(r.error.directions for r in results))
         stats = {**first.stats, "covered_texels": int(covered.sum()), "error": error and error.as_dict(),
                  "warnings": [w for r in results for w in r.stats.get("warnings", [])]}
-        merged = BakeResult(ao, covered, filled, stats, None, first.tiles, twin, error)
+        merged = BakeResult(ao, covered, filled, stats, None, first.tiles, twin, error, first.method)
         self.own_stats = {obj.name: result.stats for obj, _uv, result in self.results}
         self.results = [(obj, uv, merged) for obj, uv, _r in self.results]
 

@@ -8,7 +8,7 @@ pixel size from the texel density of the UV layout.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Generator
+from typing import Callable, Generator
 
 import numpy as np
 
@@ -89,6 +89,9 @@ class BakePlan:
     # later rounds of a bake to an error leave converged texels out, a verification bakes
     # its sample. Receivers elsewhere are dropped (bakers that can: abilities.bakes_all_cells).
     cells: np.ndarray | None = None
+    # The bake method that runs: chosen once, here (abilities.choose_method of what the bake
+    # needs), and carried forward by the baker factory and the result (BakeResult.method).
+    method: str = ""
 
     def receivers(self) -> Receivers:
         """The bake's receivers: the projected high-poly points, the target's face corners
@@ -250,11 +253,13 @@ def make_plan(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], 
 def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                     high_to_low: HighToLow | None = None, cast: RayCast | None = None,
                     vertex_target: VertexTarget | None = None, projection: tuple | None = None,
-                    cells: np.ndarray | None = None) -> Generator[float, None, BakePlan]:
+                    cells: np.ndarray | None = None, cast_for: Callable[[str], RayCast | None] | None = None
+                    ) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled. projection:
     an earlier plan's (BakePlan.projection) of the same target, sources and settings but for
-    directions and seed, used instead of casting again. cells: BakePlan.cells."""
+    directions and seed, used instead of casting again. cells: BakePlan.cells. cast_for: the
+    chosen method's ray cast (cast, where not given)."""
     settings = settings.validated()
     bake_target, occluders = _checked_inputs(target, occluders, settings, high_to_low, vertex_target)
     kind, target = bake_target.kind, bake_target.soup
@@ -263,7 +268,9 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     if not (areas > 0.0).any():
         raise BakeInputError(f"'{target.name}' has only zero-area faces")
     uv_area, udim, uv_warnings, uv_counters = _uv_layout(target, kind, settings)
-    needs = _checked_method(settings, kind, udim)  # before the projection's rays
+    method = _checked_method(settings, kind, udim)  # before the projection's rays
+    if cast is None and cast_for is not None and high_to_low is not None:
+        cast = cast_for(method)
 
     # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
@@ -286,11 +293,13 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     o_normals, _ = face_normals_areas(o_pos)
     inv_s = _inverse_normalizers(normals, areas, directions, settings)
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
-    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, needs, extent)
+    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, extent)
 
     drawn = np.concatenate(([t_pos.reshape(-1, 3)] if kind.target_occludes else []) + [o_pos.reshape(-1, 3)])
     target_weld = weld(t_pos.reshape(-1, 3))
     alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
+    if alpha is not None:  # the bake needs occluders that let light through: Auto chooses again
+        method = choose_method(settings.method, _needs(settings, kind, udim) | {"alpha"})
     holes = _drawn_holes(settings, alpha, drawn, target_weld if len(o_pos) == 0 else None)
     # Distinct corners: a light view's window is fitted to them (shared corners once); in
     # Selected to Active the corners of the grid cells that hold receivers (VIEW_FIT_CELL).
@@ -306,15 +315,22 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                     pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, bounding_sphere(drawn),
                     dense_fraction > DENSE_AREA_LIMIT,
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    holes == [], holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells)
+                    holes == [], holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells,
+                    method)
 
 
-def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> frozenset:
-    """What the bake needs of a baker; a method that cannot bake it is refused here."""
-    needs = abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
-                             settings.min_distance, settings.spread_cos > 0.0)
-    check_method(choose_method(settings.method, needs), needs, asked_phrases(udim))
-    return needs
+def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> str:
+    """The method that bakes: settings.method, or Auto's choice for what the bake needs of a
+    baker; a method that cannot bake it is refused here."""
+    needs = _needs(settings, kind, udim)
+    method = choose_method(settings.method, needs)
+    check_method(method, needs, asked_phrases(udim))
+    return method
+
+
+def _needs(settings: BakeSettings, kind, udim: UdimLayout | None) -> frozenset[str]:
+    return abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
+                            settings.min_distance, settings.spread_cos > 0.0)
 
 
 def _inverse_normalizers(normals: np.ndarray, areas: np.ndarray, directions: np.ndarray,

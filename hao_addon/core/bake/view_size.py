@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .abilities import choose_method
 from .settings import BakeSettings
 from .udim import UdimLayout
 
@@ -26,15 +25,15 @@ DENSE_AREA_LIMIT = 0.005
 
 
 def light_pixel_size(settings: BakeSettings, kind, udim: UdimLayout | None, areas: np.ndarray,
-                      uv_area: np.ndarray | None, scale: float, needs, extent: float) -> tuple[float, float]:
-    """(a light view's pixel, normalized; the scatter's dense UV-area fraction)."""
+                      uv_area: np.ndarray | None, scale: float, method: str, extent: float) -> tuple[float, float]:
+    """(a light view's pixel, normalized; the scatter's dense UV-area fraction) for the bake
+    method that runs (the plan's choice)."""
     if udim is not None:  # each tile as fine as its own bake would be: the finest of them
         tiles = [faces for faces in map(udim.faces, range(udim.count))
                  if ((areas[faces] > 0.0) & (uv_area[faces] > 0.0)).any()]  # a tile of zero-area faces asks nothing
         pixel_size = min(uv_pixel_size(settings, areas[faces], uv_area[faces], scale, "gather")[0] for faces in tiles)
         dense_fraction = 0.0  # the scatter's split, and it bakes no tiles
     elif kind.needs_uvs:
-        method = choose_method(settings.method, needs)
         pixel_size, dense_fraction = uv_pixel_size(settings, areas, uv_area, scale, method)
     else:  # Size pixels across the bounding sphere's diameter (2), times sqrt(view samples)
         pixel_size, dense_fraction = 2.0 / (settings.size * float(np.sqrt(settings.view_samples))), 0.0
