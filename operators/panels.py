@@ -17,6 +17,11 @@ def _split_layout(layout):
     return layout.column()
 
 
+def _props(layout, settings, *names: str) -> None:
+    for name in names:
+        layout.prop(settings, name)
+
+
 def _active_column(col, active: bool):
     sub = col.column()
     sub.active = active
@@ -24,10 +29,16 @@ def _active_column(col, active: bool):
 
 
 class _BakeSubPanel:
+    """A sub-panel of Bake AO (its idname is its class name): draw_settings(col, settings,
+    context) fills a property-split column."""
+
     bl_space_type = 'VIEW_3D'
     bl_region_type = 'UI'
     bl_category = "AO"
     bl_parent_id = "VIEW3D_PT_hao_bake"
+
+    def draw(self, context):
+        self.draw_settings(_split_layout(self.layout), context.scene.hao_bake, context)
 
 
 class VIEW3D_PT_hao_bake(bpy.types.Panel):
@@ -46,20 +57,15 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         col.prop(settings, "target")
         if settings.target == "color-attribute":
             col.prop(settings, "color_domain")
-        col.prop(settings, "size")
-        col.prop(settings, "occluders")
-        col.prop(settings, "method")
+        _props(col, settings, "size", "occluders", "method")
 
 
 class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
     """Where the AO map goes: UV map, image, file, frames, material"""
 
     bl_label = "Output"
-    bl_idname = "VIEW3D_PT_hao_bake_output"
 
-    def draw(self, context):
-        settings = context.scene.hao_bake
-        col = _split_layout(self.layout)
+    def draw_settings(self, col, settings, context):
         col.active = settings.target == "image"  # the image outputs
         col.prop(settings, "uv_mode")
         if settings.uv_mode == 'NAMED':
@@ -68,29 +74,23 @@ class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
                 col.prop_search(settings, "uv_map", obj.data, "uv_layers", text="Name")
             else:
                 col.prop(settings, "uv_map", text="Name")
-        col.prop(settings, "margin")
-        col.prop(settings, "texture_set")
+        _props(col, settings, "margin", "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
-        col.prop(settings, "filepath")
-        col.prop(settings, "png_bits")
+        _props(col, settings, "filepath", "png_bits")
         _active_column(col, settings.png_bits == "8").prop(settings, "dither")
-        col.prop(settings, "frame_range")
-        col.prop(settings, "wire_material")
+        _props(col, settings, "frame_range", "wire_material")
 
 
 class VIEW3D_PT_hao_bake_selected(_BakeSubPanel, bpy.types.Panel):
     """Selected to Active, and bake groups matched by name"""
 
     bl_label = "Selected to Active"
-    bl_idname = "VIEW3D_PT_hao_bake_selected"
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw_header(self, context):
         self.layout.prop(context.scene.hao_bake, "selected_to_active", text="")
 
-    def draw(self, context):
-        settings = context.scene.hao_bake
-        col = _split_layout(self.layout)
+    def draw_settings(self, col, settings, context):
         sub = _active_column(col, settings.selected_to_active)
         sub.prop(settings, "cage_object")
         _active_column(sub, settings.selected_to_active and settings.cage_object is None).prop(settings,
@@ -98,21 +98,16 @@ class VIEW3D_PT_hao_bake_selected(_BakeSubPanel, bpy.types.Panel):
         sub.prop(settings, "max_ray_distance")
         col.prop(settings, "match_names")
         sub = _active_column(col, settings.match_names)
-        sub.prop(settings, "low_suffix")
-        sub.prop(settings, "high_suffix")
-        sub.prop(settings, "group_occluders")
+        _props(sub, settings, "low_suffix", "high_suffix", "group_occluders")
 
 
 class VIEW3D_PT_hao_bake_maps(_BakeSubPanel, bpy.types.Panel):
     """The maps baked beside the AO, one block per map row"""
 
     bl_label = "Maps"
-    bl_idname = "VIEW3D_PT_hao_bake_maps"
     bl_options = {'DEFAULT_CLOSED'}
 
-    def draw(self, context):
-        settings = context.scene.hao_bake
-        col = _split_layout(self.layout)
+    def draw_settings(self, col, settings, context):
         col.active = settings.target == "image"
         for kind in EXTRA_MAPS:
             block = col.column()
@@ -128,20 +123,15 @@ class VIEW3D_PT_hao_bake_quality(_BakeSubPanel, bpy.types.Panel):
     """How exact the map must be, and checking it"""
 
     bl_label = "Quality"
-    bl_idname = "VIEW3D_PT_hao_bake_quality"
 
-    def draw(self, context):
-        settings = context.scene.hao_bake
-        col = _split_layout(self.layout)
+    def draw_settings(self, col, settings, context):
         col.prop(settings, "quality")
         if settings.quality in QUALITY_CAPS:  # a preset caps itself
             col.label(text=f"Up to {QUALITY_CAPS[settings.quality]} directions")
         else:
             col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
         _active_column(col, settings.quality in ("custom", "fixed")).prop(settings, "max_error")
-        col.prop(settings, "view_samples")
-        col.prop(settings, "samples_per_texel")
-        col.prop(settings, "seed")
+        _props(col, settings, "view_samples", "samples_per_texel", "seed")
         checked = _active_column(col, settings.target == "image")  # texels of a UV layout
         checked.prop(settings, "verify")
         _active_column(checked, settings.verify > 0).prop(settings, "verify_max_error")
@@ -151,24 +141,17 @@ class VIEW3D_PT_hao_bake_advanced(_BakeSubPanel, bpy.types.Panel):
     """What counts as an occluder and how rays leave the surface"""
 
     bl_label = "Advanced"
-    bl_idname = "VIEW3D_PT_hao_bake_advanced"
     bl_options = {'DEFAULT_CLOSED'}
 
-    def draw(self, context):
-        settings = context.scene.hao_bake
-        col = _split_layout(self.layout)
+    def draw_settings(self, col, settings, context):
         col.prop(settings, "max_distance")
         _active_column(col, settings.max_distance > 0.0).prop(settings, "falloff")
-        col.prop(settings, "weighting")
-        col.prop(settings, "spread_angle")
-        col.prop(settings, "min_distance")
-        col.prop(settings, "normals")
+        _props(col, settings, "weighting", "spread_angle", "min_distance", "normals")
         sub = _active_column(col, settings.normals == 'mesh')
         sub.prop(settings, "terminator")
         _active_column(sub, settings.normals == 'mesh' and settings.terminator == 'setting').prop(
             settings, "terminator_offset")
-        col.prop(settings, "ignore_back_faces")
-        col.prop(settings, "alpha")
+        _props(col, settings, "ignore_back_faces", "alpha")
         _active_column(col, settings.alpha == "clip").prop(settings, "alpha_clip")
 
 
