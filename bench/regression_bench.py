@@ -35,7 +35,10 @@ import json, sys, time
 import numpy as np
 import bpy
 from hao_addon.bake import HighToLow, bake
-from hao_addon.gpu.context import ensure_gpu_context
+try:
+    from hao_addon.gpu.context import ensure_gpu_context
+except ImportError:  # a revision before the GPU context moved (13a9a82 and earlier)
+    from hao_addon.blender.gpu_context import ensure_gpu_context
 from hao_addon.core.bake.settings import BakeSettings
 from hao_addon.core.geometry import TriangleSoup
 inputs, out, repeats = sys.argv[-3], sys.argv[-2], int(sys.argv[-1])
