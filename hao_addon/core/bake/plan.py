@@ -24,7 +24,7 @@ from ..steps import drain
 from .projection import HighToLow, RayCast, check_high_to_low, projected_receivers_steps
 from .receivers import Receivers, corner_receivers, uv_receivers
 from .settings import BakeSettings
-from .uv_checks import uv_layout_warnings
+from .uv_checks import tile_layout_warnings
 from .udim import UdimLayout, udim_layout
 from .target_kinds import TARGET_KINDS, TargetKind
 from .targets import BakeTarget, as_bake_target
@@ -264,31 +264,20 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     bake_target, occluders = _checked_inputs(target, occluders, settings, high_to_low, vertex_target)
     kind, target = bake_target.kind, bake_target.soup
     high_to_low, vertex_target = bake_target.high_to_low, bake_target.corners
-    normals, areas = face_normals_areas(target.positions)
-    if not (areas > 0.0).any():
-        raise BakeInputError(f"'{target.name}' has only zero-area faces")
+    normals, areas = _face_normals_areas(target)
     uv_area, udim, uv_warnings, uv_counters = _uv_layout(target, kind, settings)
     method = _checked_method(settings, kind, udim)  # before the projection's rays
     if cast is None and cast_for is not None and high_to_low is not None:
         cast = cast_for(method)
-
-    # Normalize: the target's bounding sphere maps to the unit sphere. float64 until here.
     flat = target.positions.reshape(-1, 3)
-    centre, radius = bounding_sphere(flat)
-    scale = radius if radius > 0.0 else 1.0
-    t_pos = (target.positions - centre) / scale
+    centre, scale, t_pos = _normalized(target)
     directions = bake_directions(settings.directions, settings.seed)
 
-    # Selected to Active: the receivers are the sources' points the texels project to.
-    projected, projection_stats, extent = None, {}, 1.0  # extent: the receivers' sphere's radius, normalized
-    if high_to_low is not None:
-        if projection is None:
-            projection = yield from projected_receivers_steps(target, high_to_low, settings, centre, scale, cast, udim)
-        projected, projection_stats, warning = projection
-        uv_warnings = uv_warnings + ([warning] if warning else [])
-        if len(projected):
-            extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max()))
-            flat = np.concatenate([flat, projected.points * scale + centre])
+    projection = yield from _projection(target, high_to_low, settings, centre, scale, cast, udim, projection)
+    projected, projection_stats, extent, warnings = _projected(projection)
+    uv_warnings = uv_warnings + warnings
+    if projected is not None and len(projected):
+        flat = np.concatenate([flat, projected.points * scale + centre])
     o_pos, alpha_parts, culling = _drawn_occluders(occluders, flat, settings, kind, target, centre, scale)
     o_normals, _ = face_normals_areas(o_pos)
     inv_s = _inverse_normalizers(normals, areas, directions, settings)
@@ -317,6 +306,42 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
                     smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
                     holes == [], holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells,
                     method)
+
+
+def _face_normals_areas(target: TriangleSoup) -> tuple[np.ndarray, np.ndarray]:
+    """face_normals_areas of the target, which must have a face of some area."""
+    normals, areas = face_normals_areas(target.positions)
+    if not (areas > 0.0).any():
+        raise BakeInputError(f"'{target.name}' has only zero-area faces")
+    return normals, areas
+
+
+def _normalized(target: TriangleSoup) -> tuple[np.ndarray, float, np.ndarray]:
+    """(centre, scale, the target's corners (F, 3, 3) normalized): its bounding sphere maps to
+    the unit sphere. float64 until here."""
+    centre, radius = bounding_sphere(target.positions.reshape(-1, 3))
+    scale = radius if radius > 0.0 else 1.0
+    return centre, scale, (target.positions - centre) / scale
+
+
+def _projection(target: TriangleSoup, high_to_low: HighToLow | None, settings: BakeSettings, centre: np.ndarray,
+                scale: float, cast: RayCast | None, udim: UdimLayout | None, earlier: tuple | None
+                ) -> Generator[float, None, tuple | None]:
+    """Selected to Active: the receivers are the sources' points the texels project to
+    (projected_receivers_steps; an earlier round's where given). None without high_to_low."""
+    if high_to_low is None or earlier is not None:
+        return earlier if high_to_low is not None else None
+    return (yield from projected_receivers_steps(target, high_to_low, settings, centre, scale, cast, udim))
+
+
+def _projected(projection: tuple | None) -> tuple:
+    """(the projected receivers or None, their stats, the receivers' sphere's radius about the
+    origin, normalized (1: the target's), the projection's warnings)."""
+    if projection is None:
+        return None, {}, 1.0, []
+    projected, stats, warning = projection
+    extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max())) if len(projected) else 1.0
+    return projected, stats, extent, [warning] if warning else []
 
 
 def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> str:
@@ -376,7 +401,7 @@ def _uv_layout(target: TriangleSoup, kind, settings: BakeSettings) -> tuple:
     if not (uv_area > 0.0).any():
         raise BakeInputError(f"'{target.name}': every UV triangle has zero area (is the UV map empty?)")
     udim = udim_layout(target.uvs)
-    return (uv_area, udim, *_layout_warnings(target, settings.size, udim))
+    return (uv_area, udim, *tile_layout_warnings(target, settings.size, udim))
 
 
 def _drawn_occluders(occluders: list[TriangleSoup], flat: np.ndarray, settings: BakeSettings, kind,
@@ -435,26 +460,6 @@ def _plan_stats(target: TriangleSoup, settings: BakeSettings, areas: np.ndarray,
                 samples_per_texel=settings.sample_count, warnings=warnings,
                 alpha_faces=0 if alpha is None else int(((alpha.constant < 1.0) | (alpha.layer >= 0)).sum()),
                 **counters)
-
-
-def _layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:
-    """uv_layout_warnings of the 0..1 tile, or of each UDIM tile (its triangles moved into
-    0..1; counters summed, the overlap fraction the largest)."""
-    if udim is None:
-        return uv_layout_warnings(target.uvs, size, target.name)
-    warnings, counters = [], {}
-    for tile, number in enumerate(udim.tiles):
-        _faces, local = udim.local_uvs(target.uvs, tile)
-        tile_warnings, tile_counters = uv_layout_warnings(local, size, f"{target.name}' tile '{number}")
-        warnings += tile_warnings
-        for key, value in tile_counters.items():
-            if isinstance(value, bool):
-                counters[key] = counters.get(key, True) and value
-            elif key.endswith("fraction"):
-                counters[key] = max(counters.get(key, 0.0), value)
-            else:
-                counters[key] = counters.get(key, 0) + value
-    return warnings, counters
 
 
 def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,

@@ -10,6 +10,9 @@ from collections import OrderedDict
 
 import numpy as np
 
+from ..geometry import TriangleSoup
+from .udim import UdimLayout
+
 # Overlaps are counted at texel centres of a map at most this large (cost ~ UV area x side^2).
 CHECK_SIDE = 512
 # Fractions below these are rounding at shared edges, not a layout problem.
@@ -105,3 +108,23 @@ def _layout_counts(uvs: np.ndarray, size: int) -> dict:
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return {**counts, "uv_check_cached": False}
+
+
+def tile_layout_warnings(target: TriangleSoup, size: int, udim: UdimLayout | None) -> tuple[list[str], dict]:
+    """uv_layout_warnings of the 0..1 tile, or of each UDIM tile (its triangles moved into
+    0..1; counters summed, the overlap fraction the largest)."""
+    if udim is None:
+        return uv_layout_warnings(target.uvs, size, target.name)
+    warnings, counters = [], {}
+    for tile, number in enumerate(udim.tiles):
+        _faces, local = udim.local_uvs(target.uvs, tile)
+        tile_warnings, tile_counters = uv_layout_warnings(local, size, f"{target.name}' tile '{number}")
+        warnings += tile_warnings
+        for key, value in tile_counters.items():
+            if isinstance(value, bool):
+                counters[key] = counters.get(key, True) and value
+            elif key.endswith("fraction"):
+                counters[key] = max(counters.get(key, 0.0), value)
+            else:
+                counters[key] = counters.get(key, 0) + value
+    return warnings, counters
