@@ -17,7 +17,7 @@ done
 
 logs="$(mktemp -d)"
 pids=()
-trap 'kill "${pids[@]}" 2>/dev/null; rm -rf "$logs"; exit 130' INT TERM
+trap 'trap - INT TERM; rm -rf "$logs"; kill 0; exit 130' INT TERM  # the whole process group: every suite at once
 for i in "${!releases[@]}"; do
   venv="${venvs[$i]}"
   (
