@@ -22,9 +22,6 @@ SPOT = ROOT / "samples" / "spot.obj"
 BUNNY = ROOT / "bench" / "data" / "stanford-bunny.obj"
 
 
-env_for = cli_env
-
-
 def run(args, tmp: Path, **kw):
     return run_hao(args, cwd=tmp, **kw)
 
@@ -152,7 +149,7 @@ def start_on_pty(args, tmp: Path):
     """Start the CLI with stderr on a pseudo-terminal (as in an interactive shell)."""
     master, slave = pty.openpty()
     proc = subprocess.Popen([sys.executable, "-m", "hao_addon", *map(str, args)], stdout=subprocess.PIPE,
-                            stderr=slave, stdin=subprocess.DEVNULL, env=env_for(tmp), cwd=tmp)
+                            stderr=slave, stdin=subprocess.DEVNULL, env=cli_env(tmp), cwd=tmp)
     os.close(slave)
     return proc, master
 
@@ -237,7 +234,7 @@ def test_signal_during_unwrap_stops_at_once(dirs, signum, code, word):
     sphere = big_sphere_obj(tmp.parent / "big_sphere.obj")
     proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", sphere, "--size", "512", "--directions", "8",
                              "--out", out / "a.png"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env=env_for(tmp), cwd=tmp, text=True)
+                            env=cli_env(tmp), cwd=tmp, text=True)
     end = time.monotonic() + 60
     while not children_of(proc.pid) and time.monotonic() < end and proc.poll() is None:
         time.sleep(0.05)
@@ -288,7 +285,7 @@ def test_signal_at_any_moment_stops_cleanly(dirs, delay, signum, code):
     out, tmp = dirs
     proc = subprocess.Popen([sys.executable, "-m", "hao_addon", "bake", ROOT / "tests" / "data" / "CesiumMan.glb",
                              "--size", "256", "--directions", "16384", "--out", out / "a.png"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env_for(tmp), cwd=tmp, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=cli_env(tmp), cwd=tmp, text=True)
     time.sleep(delay)
     t0 = time.monotonic()
     proc.send_signal(signum)

@@ -29,14 +29,15 @@ def orm_map(request: BakeRequest, obj, depsgraph, target: TriangleSoup, result: 
     roughness, metallic = roughness_metallic(obj, depsgraph, target.uvs, settings.size, settings.margin)
     return orm_image(result.ao, roughness, metallic)
 
+
 def bent_normal_image(request: BakeRequest, objects: list, depsgraph, uv_names: list[str], target: TriangleSoup,
                       result: BakeResult) -> np.ndarray:
     """(size, size, 4) encoded bent-normal image of a finished bake of objects (one, or a
     texture set's, whose target is their soups in that order), in the request's space."""
-    req = request
     linear = np.array(objects[0].evaluated_get(depsgraph).matrix_world, dtype=np.float64)[:3, :3]
+    space, convention, margin = request.options.bent_space, request.options.bent_convention, request.settings.margin
     tangents = normals = None
-    if req.options.bent_space == "tangent":
+    if space == "tangent":
         tangents = np.concatenate([mesh_data.corner_tangents(o, depsgraph, uv)
                                    for o, uv in zip(objects, uv_names)])
         # The world corner normals as they are (not re-normalized: on a scaled object that
@@ -45,14 +46,14 @@ def bent_normal_image(request: BakeRequest, objects: list, depsgraph, uv_names: 
         if normals is None:  # flat shading: every corner has its face's normal
             normals = np.repeat(face_normals_areas(target.positions)[0][:, None, :], 3, axis=1)
     if result.tiles is None:
-        return bent_normal_map(result.bent_normals, result.covered, result.filled, req.settings.margin,
-                               target.uvs, req.options.bent_space, req.options.bent_convention, linear, tangents, normals)
+        return bent_normal_map(result.bent_normals, result.covered, result.filled, margin, target.uvs, space,
+                               convention, linear, tangents, normals)
     layout = udim_layout(target.uvs)  # one map per tile, from the tile's own triangles
     maps = []
     for tile in range(layout.count):
         faces, local = layout.local_uvs(target.uvs, tile)
         maps.append(bent_normal_map(result.bent_normals[tile], result.covered[tile], result.filled[tile],
-                                    req.settings.margin, local, req.options.bent_space, req.options.bent_convention, linear,
+                                    margin, local, space, convention, linear,
                                     None if tangents is None else tangents[faces],
                                     None if normals is None else normals[faces]))
     return np.stack(maps)

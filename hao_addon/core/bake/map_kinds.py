@@ -78,4 +78,3 @@ MAP_KINDS = (
 )
 # The maps besides the AO, each with a file option of its own.
 EXTRA_MAPS = MAP_KINDS[1:]
-MAPS_BY_NAME = {kind.name: kind for kind in MAP_KINDS}

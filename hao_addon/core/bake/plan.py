@@ -120,9 +120,7 @@ class BakePlan:
     @property
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
-        settings = self.settings
-        needs = abilities_needed(settings.max_distance, settings.bent_normals, self.kind, self.udim is not None,
-                                 settings.min_distance, settings.spread_cos > 0.0)
+        needs = _needs(self.settings, self.kind, self.udim)
         return needs | {"alpha"} if self.alpha is not None else needs
 
     def check_method(self, method: str) -> None:
@@ -354,6 +352,8 @@ def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> st
 
 
 def _needs(settings: BakeSettings, kind, udim: UdimLayout | None) -> frozenset[str]:
+    """What a bake with these settings, this target kind and (where tiled) UDIM layout needs
+    of a baker, occluders that let light through aside (BakePlan.abilities_needed adds them)."""
     return abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
                             settings.min_distance, settings.spread_cos > 0.0)
 
