@@ -74,3 +74,20 @@ def test_the_panel_writes_every_map_it_has_a_field_for(scene, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["ao.png", *(f"{k.key}.png" for k in EXTRA_MAPS)])
     ao, orm = load_image_rgba(tmp_path / "ao.png"), load_image_rgba(tmp_path / "orm.png")
     np.testing.assert_array_equal(orm[..., 0], ao[..., 0])
+
+
+def test_a_new_map_row_leaves_the_skip_key_of_bakes_without_it(monkeypatch):
+    """The --skip-existing key counts the maps a bake writes, so adding a map row does not
+    make every earlier file look stale."""
+    from dataclasses import replace
+
+    from hao_addon.cli import skip
+    from hao_addon.cli.parser import build_parser
+    from hao_addon.core.bake.map_kinds import EXTRA_MAPS
+    from test_cli_runs import SPOT
+
+    base = build_parser().parse_args(["bake", str(SPOT), "--out", "a.png"])
+    key = skip.run_key(base, [SPOT])
+    future = replace(EXTRA_MAPS[-1], name="future", key="future", skip_key="future_file")
+    monkeypatch.setattr(skip, "EXTRA_MAPS", (*EXTRA_MAPS, future))
+    assert skip.run_key(base, [SPOT]) == key

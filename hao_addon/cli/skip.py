@@ -41,8 +41,9 @@ def run_key(args, input_files: list[Path]) -> str:
     for path in input_files:
         h.update(file_digest(path))
     options = {name: value for name, value in vars(args).items() if name not in NOT_IN_KEY}
-    for kind in EXTRA_MAPS:  # which maps are written counts, not where
-        options[kind.skip_key] = bool(getattr(args, kind.option, ""))
+    # Which maps are written counts, not where; a map not written adds nothing, so a new map
+    # row leaves the keys of bakes without it as they were.
+    options.update({kind.skip_key: True for kind in EXTRA_MAPS if getattr(args, kind.option, "")})
     options["high_poly_names"] = [spec for spec in args.high_poly or () if not Path(spec).is_file()]
     h.update(json.dumps(options, sort_keys=True, default=str).encode())
     return h.hexdigest()
