@@ -23,14 +23,14 @@ from .core.geometry import TriangleSoup, bounding_sphere
 from .core.errors import BakeInputError
 from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
-from .core.bake.estimators import BENT_NORMALS
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
     replicate_twin, with_floor, directions_for
 from .floor_check import floor_sample, floor_steps, probe_steps, take_probe
 from .replicates import replicate_sums_steps
-from .core.bake.seams import dilate, element_values, estimated, finalize_map, finalize_vectors
+from .core.bake.seams import dilate, finalize_vectors
 from .core.bake.settings import QUALITY_CAPS, BakeSettings
-from .core.bake.abilities import check_method, choose_method, declaration
+from .core.bake.abilities import declaration
+from .core.bake.bake_run import BakeRun
 from .core.bake.targets import BakeTarget, as_bake_target
 from .core.bake.vertex_target import VertexTarget
 
@@ -91,14 +91,17 @@ _CACHE_SIZE = 8
 
 
 def bake_key(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
-             high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None) -> str:
-    """A digest of everything a bake's result depends on (geometry, UVs, normals, settings):
-    equal keys bake equal maps. The cache's key, and a frame sequence's test for a frame
-    that repeats an earlier one."""
+             high_to_low: HighToLow | None = None, vertex_target: VertexTarget | None = None,
+             needs: frozenset[str] = frozenset()) -> str:
+    """A digest of everything a bake's result depends on (geometry, UVs, normals, settings,
+    abilities needed beyond the settings'): equal keys bake equal maps. The cache's key, and
+    a frame sequence's test for a frame that repeats an earlier one."""
     bake_target = as_bake_target(target, settings.target, high_to_low, vertex_target)
     target, high_to_low, vertex_target = bake_target.soup, bake_target.high_to_low, bake_target.corners
     h = hashlib.blake2b(digest_size=20)
     h.update(repr(settings.cache_key()).encode())
+    if needs:  # (nothing added without: the keys of plain bakes stay as they were)
+        h.update(repr(sorted(needs)).encode())
     if vertex_target is not None:
         h.update(b"|vertex-target|%d|" % vertex_target.count)
         h.update(np.ascontiguousarray(vertex_target.cells).tobytes())
@@ -135,11 +138,13 @@ def clear_cache() -> None:
 
 def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                use_cache: bool = True, high_to_low: HighToLow | None = None,
-               vertex_target: VertexTarget | None = None) -> Generator[float, None, BakeResult]:
+               vertex_target: VertexTarget | None = None, needs: frozenset[str] = frozenset()
+               ) -> Generator[float, None, BakeResult]:
     """Bake `target` (with UVs) against itself and `occluders`; yields progress in [0, 1].
     With `high_to_low`, bake its sources onto the target's UVs (Selected to Active); with
     settings.target 'color-attribute', at the face corners of `vertex_target` (no UVs).
-    target may be a BakeTarget (core/bake/targets.py) that holds either itself.
+    target may be a BakeTarget (core/bake/targets.py) that holds either itself. needs:
+    abilities the bake needs of a baker beyond its settings' (BakeRun.needs: thickness).
 
     A re-bake of identical geometry, UVs and settings returns the cached result at once
     (the GPU is not touched). Raises BakeInputError for input that cannot be baked.
@@ -148,7 +153,7 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
     if settings.spread_cos > 0.0 and settings.directions * math.sin(math.radians(settings.spread_angle)) ** 2 < 1.0:
         raise BakeInputError("spread angle: " + spread_warning(settings, settings.directions).replace("the map is", "the map would be"))
     target = as_bake_target(target, settings.target, high_to_low, vertex_target)
-    key = bake_key(target, occluders, settings) if use_cache else None
+    key = bake_key(target, occluders, settings, needs=needs) if use_cache else None
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         cached = _CACHE[key]
@@ -161,15 +166,18 @@ def bake_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup],
         # The floor check samples more texels for bakes of more directions (floor_texel_count).
         shared: dict = {"floor_directions": settings.direction_cap if settings.error_target > 0.0
                         else settings.directions}
-        checked = not declaration(settings.method_for(target.high_to_low is not None)).floor_unchecked
-        share = FLOOR_PROGRESS_SHARE if checked else 0.0
+        run = BakeRun.of(settings, needs)
         if settings.error_target > 0.0:
-            baking = _bake_to_error(target, occluders, settings, shared)
+            baking = _bake_to_error(target, occluders, settings, run, shared)
         else:
-            baking = _bake_uncached(target, occluders, settings, shared)
-        result = yield from relay(baking, lambda fraction: (1.0 - share) * fraction)
+            baking = _bake_uncached(target, occluders, settings, run, shared)
+
+        def share() -> float:  # the floor check's, once the plan has chosen the method (shared["method"])
+            unchecked = "method" in shared and declaration(shared["method"]).floor_unchecked
+            return 0.0 if unchecked else FLOOR_PROGRESS_SHARE
+        result = yield from relay(baking, lambda fraction: (1.0 - share()) * fraction)
         result = yield from relay(_with_floor_steps(result, shared, settings, target.name),
-                                  lambda fraction: 1.0 - share + share * fraction)
+                                  lambda fraction: 1.0 - share() + share() * fraction)
     result.stats.update(blas_threads_held=blas_threads is not None, seconds=time.perf_counter() - t0,
                         target_name=target.name)
     directions = result.error.directions if result.error is not None else settings.directions
@@ -202,47 +210,28 @@ def spread_warning(settings: BakeSettings, directions: int) -> str:
             f"raise the spread angle or Directions (about {MIN_DIRECTIONS_IN_CONE / share:.3g})")
 
 
-def _finished_maps(plan, sums: np.ndarray) -> tuple:
-    """(ao, covered, filled, bent normals or None) of a bake's summed estimator: the map from
-    its sums with margins and seams (core/bake/seams.py), one per UDIM tile where tiled, or
-    the colour attribute's values, one per element."""
-    margin = plan.settings.margin
-    if plan.vertex_target is not None:
-        return (*element_values(*plan.estimator.ratio(sums)), None)
-    tiles = sums if plan.udim is not None else sums[None]  # each tile with its own margins
-    maps = [finalize_map(*plan.estimator.ratio(tile), margin) for tile in tiles]
-    ao, covered, filled = (np.stack(part) for part in zip(*maps))
-    bent = None
-    if plan.estimator is BENT_NORMALS:
-        bent = np.stack([finalize_vectors(BENT_NORMALS.bent(tile), c, f, margin)
-                         for tile, c, f in zip(tiles, covered, filled)])
-    if plan.udim is None:
-        return ao[0], covered[0], filled[0], None if bent is None else bent[0]
-    return ao, covered, filled, bent
-
-
-def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
+def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, run: BakeRun,
                    shared: dict | None = None) -> Generator[float, None, BakeResult]:
-    """bake_steps without its cache: plan, run the baker's directions, finish the output.
-    shared: kept across the rounds of a bake to an error; the Selected-to-Active projection
-    is stored there and reused (BakePlan.projection), and the caller puts the cells a round
-    bakes there (BakePlan.cells)."""
+    """bake_steps without its cache: plan `run` (core/bake/bake_run.py: its directions, seed,
+    cells), run the baker's directions, finish the output. shared: kept across the rounds of
+    a bake to an error; what a later round may reuse of the plan (the Selected-to-Active
+    projection, BakePlan.layout.reusable) is stored there, and the method that ran."""
     from .bakers import BAKE_METHODS, baker_for, ray_cast_name, ray_caster_for  # deferred: need a GPU context
     projects = target.high_to_low is not None
     share = PROJECTION_PROGRESS_SHARE if projects else 0.0
     shared = {} if shared is None else shared
     # The plan chooses the method (BakePlan.method), and the projection casts with its own rays.
-    planning = make_plan_steps(target, occluders, settings, projection=shared.get("projection"),
-                               cells=shared.get("cells"), cast_for=ray_caster_for)
+    planning = make_plan_steps(target, occluders, settings, projection=shared.get("projection"), run=run,
+                               cast_for=ray_caster_for)
     plan = yield from relay(planning, lambda fraction: share * fraction)  # a cancel stops the projection
-    shared["projection"] = plan.projection
-    method = plan.method
+    shared["projection"] = plan.layout.reusable()
+    method = shared["method"] = plan.method
     cast_stats = {"ray_cast": ray_cast_name(method)} if projects and method in BAKE_METHODS else {}
     baker_cls = baker_for(method)
     baker_cls.check_limits(plan)
     baker = baker_cls(plan)
     try:
-        count = settings.directions
+        count = plan.direction_count
         best = shared["floor_probe"].half if shared.get("floor_probe") else 0
         snapshots = probe_steps(method, count, best)
         sums_a, sums_b = yield from replicate_sums_steps(baker, count, share, snapshots)
@@ -254,32 +243,31 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             # from their neighbours, and checking their own partial sums stated a floor the map
             # does not have (the rocker arm at 128^2, 1024 directions: 0.0083 where 0.0065 is
             # measured in all).
-            checked = estimated(plan.estimator.ratio(sums)[1], elements=plan.vertex_target is not None)
+            checked = plan.layout.estimated(plan.estimator.ratio(sums)[1])
             shared["floor_sample"] = floor_sample(method, checked, baker, shared.get("floor_directions", count),
-                                                  settings.seed)
+                                                  plan.seed)
         if snapshots is not None and shared["floor_sample"] is not None:
             shared["floor_probe"] = take_probe(plan, baker, count, snapshots, shared["floor_sample"].cells,
                                                (sums_b if sums_a is None else sums_a, sums_b))
     finally:
         baker.free()
-    ao, covered, filled, bent = _finished_maps(plan, sums)
+    ao, covered, filled, bent = plan.layout.finished(plan.estimator, sums, settings.margin)
     twin = None if sums_a is None else replicate_twin(*plan.estimator.ratio(sums_a), *plan.estimator.ratio(sums_b))
     if twin is not None:
         twin = np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
     error = None if twin is None else estimate(twin, covered, count)
-    if not covered.any() and target.kind_name != "corners":
+    if not covered.any() and not plan.layout.per_element:
         # A map of no texel is not a bake: a success here would hand back an empty image.
         raise BakeInputError(f"'{target.name}': no texel centre of the {settings.size}x{settings.size} map lies "
                              f"inside its UV triangles (they lie outside the 0..1 tile, or are smaller than a "
                              f"texel): nothing to bake; check its UV map")
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "cache_hit": False, "error": None if error is None else error.as_dict()}
-    tile_numbers = None if plan.udim is None else tuple(int(t) for t in plan.udim.tiles)
-    return BakeResult(ao, covered, filled, stats, bent, tile_numbers, twin, error, method)
+    return BakeResult(ao, covered, filled, stats, bent, plan.layout.tiles, twin, error, method)
 
 
-def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, shared: dict
-                   ) -> Generator[float, None, BakeResult]:
+def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, first_run: BakeRun,
+                   shared: dict) -> Generator[float, None, BakeResult]:
     """Rounds of whole bakes, each with its own direction set, until the estimated p99 of their
     union is within settings.error_target or settings.direction_cap is spent (capped). Each
     round's size is predicted from the error so far (core/bake/error_estimate.next_round).
@@ -296,14 +284,13 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     work = skipped = 0.0  # texel x direction pairs: all of them, and those left out
     size, done, shown, cells, skips = min(cap, PILOT_DIRECTIONS), 0, 0.0, None, True
     while size > 0:
-        round_settings = replace(settings, directions=size, quality="fixed", max_error=0.0,
-                                 seed=(settings.seed + 7919 * len(rounds)) % 2**31)
-        shared["cells"] = cells if skips and SKIP_CONVERGED else None
+        run = replace(first_run, directions=size, seed=(settings.seed + 7919 * len(rounds)) % 2**31,
+                      cells=cells if skips and SKIP_CONVERGED else None)
         def overall(fraction: float, done: int = done, size: int = size) -> float:
             nonlocal shown  # progress never goes back when a round is added
             shown = max(shown, min(0.99, (done + fraction * size) / max(done + size, 1)))
             return shown
-        part = yield from relay(_bake_uncached(target, occluders, round_settings, shared), overall)
+        part = yield from relay(_bake_uncached(target, occluders, settings, run, shared), overall)
         skips = not declaration(part.method).bakes_all_cells
         rounds.append((size, part))
         done += size
@@ -446,17 +433,15 @@ def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: boo
     distance = settings.thickness_distance
     if distance == 0.0:
         distance = float(bounding_sphere(target.positions.reshape(-1, 3))[1])
+    # The AO bake of the inverted soup within the distance: a bake of its own (its own cache
+    # key), whose baker must be able to bake thickness (core/bake/abilities.py: the plan chooses).
     inside = replace(settings, max_distance=distance, bent_normals=False, thickness=False, target="image")
-    # Its own method: a baker must be able to bake thickness (core/bake/abilities.py).
-    needs = inside.abilities_needed(False) | {"thickness"}
-    method = choose_method(settings.method, needs)
-    check_method(method, needs)
-    inside = replace(inside, method=method)
     # About the true (flat) inverted surface: with shading normals, directions below a face
     # but inside the smooth hemisphere count as occluded at distance 0 (Cycles' AO convention:
     # the ray enters the surface), which for thickness is the ray leaving the mesh; they gave
     # thickness up to 0.47 within a distance of 1e-30.
-    result = yield from bake_steps(inverted(replace(target, normals=None)), [], inside, use_cache)
+    result = yield from bake_steps(inverted(replace(target, normals=None)), [], inside, use_cache,
+                                   needs=frozenset({"thickness"}))
     stats = {**result.stats, "thickness_distance": distance}
     twin = None if result.twin is None else -result.twin  # 1 - ao errs by minus ao's error
     return BakeResult(1.0 - result.ao, result.covered, result.filled, stats, None, result.tiles, twin, result.error,

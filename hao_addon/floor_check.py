@@ -29,7 +29,7 @@ stop converging at RMSE 0.0015-0.005 (128^2, flat), where the twins alone stated
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Generator
 
 import numpy as np
@@ -245,7 +245,7 @@ def _exact_steps(plan: BakePlan, cells: np.ndarray, receivers: tuple[Receivers, 
     """(2, n) the CPU reference's value at `cells` (n,) from each replicate's receivers along
     its `steps` (direction indices of plan's directions), NaN where unlit. Yields progress."""
     from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
-    plan = replace(plan, cells=cells)
+    plan = plan.with_cells(cells)
     exact = np.full((2, len(cells)), np.nan)
     total = sum(len(part) for part in steps)
     done = 0

@@ -4,13 +4,13 @@
 input and output are numpy, as in hao_addon.bake."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Generator
 
 import numpy as np
 
 from .bake import BakeResult
 from .replicates import replicate_sums_steps
+from .core.bake.bake_run import BakeRun
 from .core.bake.error_estimate import replicate_twin
 from .core.bake.plan import make_plan_steps
 from .core.bake.reference_baker import ReferenceBaker
@@ -28,9 +28,8 @@ def verify_steps(target: BakeTarget, occluders: list[TriangleSoup], settings: Ba
     cells = pick_cells(result.covered, count, settings.seed)
     if len(cells) == 0:
         return None
-    reference = replace(settings, method="reference", directions=VERIFY_DIRECTIONS, quality="fixed", max_error=0.0,
-                        bent_normals=False, seed=(settings.seed + VERIFY_SEED) % 2**31)
-    plan = yield from make_plan_steps(target, occluders, reference, cells=cells)  # a projection's rays yield progress too
+    run = BakeRun(VERIFY_DIRECTIONS, (settings.seed + VERIFY_SEED) % 2**31, "reference", cells, ao_only=True)
+    plan = yield from make_plan_steps(target, occluders, settings, run=run)  # a projection's rays yield progress too
     baker = ReferenceBaker(plan)
     try:
         sums_a, sums_b = yield from replicate_sums_steps(baker, VERIFY_DIRECTIONS)

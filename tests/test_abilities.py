@@ -11,7 +11,8 @@ import pytest
 
 from hao_addon.core import scenes
 from hao_addon.core.bake.abilities import (ABILITIES, ABILITY_NAMES, BAKE_METHODS, BAKERS, bakers_with,
-                                           check_method, choose_method, declaration)
+                                           choose_method, declaration)
+from hao_addon.core.bake.bake_run import BakeRun
 from hao_addon.core.bake.plan import make_plan
 from hao_addon.core.bake.projection import HighToLow
 from hao_addon.core.bake.settings import METHODS, BakeSettings
@@ -31,7 +32,7 @@ def plan_needing(ability: str, method: str):
             raise AssertionError("the projection ran before the method was refused")
         import bpy  # noqa: F401 - makes mathutils (the CPU cast's BVH) importable
         from hao_addon.core.bake.projection import project_steps
-        cast = project_steps if declaration(method).can(ability) else no_cast
+        cast = project_steps if method == "auto" or declaration(method).can(ability) else no_cast
         return make_plan(scenes.grid_plane(2.0, 2, z=0.5, name="low"), [], BakeSettings(**kw),
                          high_to_low=HighToLow([plane]), cast=cast)
     if ability == "bent-normals":
@@ -54,9 +55,9 @@ def plan_needing(ability: str, method: str):
         card = scenes.grid_plane(2.0, 2, z=0.5, name="card")
         card = TriangleSoup(card.positions, None, "card", alpha=SoupAlpha(np.full(card.face_count, 0.5, np.float32)))
         return make_plan(plane, [card], BakeSettings(**kw))
-    if ability == "thickness":  # a need of thickness_steps (tests/test_thickness.py), not of a plan
-        check_method(method, frozenset({"max-distance", "thickness"}))
-        return make_plan(plane, [], BakeSettings(max_distance=1.0, **kw))
+    if ability == "thickness":  # a need of thickness_steps' run (tests/test_thickness.py), not of its settings
+        settings = BakeSettings(max_distance=1.0, **kw)
+        return make_plan(plane, [], settings, run=BakeRun.of(settings, frozenset({"thickness"})))
     raise AssertionError(f"no scene needs {ability}")
 
 
@@ -66,7 +67,7 @@ def test_a_plan_is_refused_exactly_where_its_method_lacks_the_ability(baker, abi
     refused before any work otherwise, naming what is asked, why, and the methods that can."""
     if baker.can(ability.name):
         plan = plan_needing(ability.name, baker.method)
-        assert ability.name in plan.abilities_needed or ability.name == "thickness"
+        assert ability.name in plan.abilities_needed
         plan.check_method(baker.method)
         return
     with pytest.raises(BakeInputError) as refused:
@@ -105,12 +106,11 @@ def test_auto_takes_the_scatter_for_a_max_distance_alone_otherwise_the_gather():
             assert choose_method("auto", needs) == ("scatter" if by_scatter else "gather"), needs
 
 
-def test_settings_choose_through_the_declarations():
-    assert BakeSettings(max_distance=1.0).method_for(False) == "scatter"
-    assert BakeSettings(max_distance=1.0).method_for(True) == "gather"
-    assert BakeSettings(max_distance=1.0).method_for(False, tiled=True) == "gather"
-    assert BakeSettings(max_distance=1.0, target="color-attribute").method_for(False) == "gather"
-    assert BakeSettings().method_for(False) == "gather"
+def test_the_plan_chooses_through_the_declarations():
+    """The one place a method is chosen (issue 40 item 4): the plan, from what the bake needs."""
+    for ability, method in (("max-distance", "scatter"), ("selected-to-active", "gather"), ("udim", "gather"),
+                            ("color-attribute", "gather"), ("thickness", "scatter"), ("bent-normals", "gather")):
+        assert plan_needing(ability, "auto").method == method, ability
 
 
 def test_the_methods_setting_and_the_factory_list_the_declared_bakers():

@@ -13,6 +13,7 @@ from hao_addon.core import scenes
 from hao_addon.core.errors import BakeInputError
 from hao_addon.core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS
 from hao_addon.core.bake.settings import BakeSettings
+from hao_addon.core.bake.plan import make_plan
 from hao_addon.core.bake.abilities import bakers_with
 from test_bake_analytic import floor_and_wall
 
@@ -63,8 +64,8 @@ def test_bent_normals_leave_the_ao_unchanged_and_need_a_gather(gpu_context):
     both = bake(floor, [wall], BakeSettings(method="gather", bent_normals=True, **kw), use_cache=False)
     np.testing.assert_array_equal(plain.ao, both.ao)
     assert plain.bent_normals is None
-    assert BakeSettings(max_distance=1.0, bent_normals=True).method_for(False) == "gather"
-    assert BakeSettings(max_distance=1.0).method_for(False) == "scatter"
+    assert make_plan(floor, [wall], BakeSettings(max_distance=1.0, bent_normals=True, **kw)).method == "gather"
+    assert make_plan(floor, [wall], BakeSettings(max_distance=1.0, **kw)).method == "scatter"
     with pytest.raises(BakeInputError, match="histogram scatter cannot bake bent normals"):
         bake(floor, [wall], BakeSettings(method="scatter", bent_normals=True, **kw), use_cache=False)
 

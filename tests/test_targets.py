@@ -58,7 +58,7 @@ def test_a_plan_of_a_target_equals_the_plan_of_its_parts():
     by_target = make_plan(BakeTarget.of(low, "image", request), [], SETTINGS)
     assert by_target.kind is by_parts.kind is TARGET_KINDS["projected"]
     assert not by_target.target_drawn  # the row: Selected to Active's low-poly does not occlude
-    np.testing.assert_array_equal(by_target.projected.points, by_parts.projected.points)
+    np.testing.assert_array_equal(by_target.layout.projected.points, by_parts.layout.projected.points)
     np.testing.assert_array_equal(by_target.drawn_positions, by_parts.drawn_positions)
     own = make_plan(BakeTarget.of(low, "image"), relief, SETTINGS)
     assert own.target_drawn and len(own.drawn_positions) == low.face_count + sum(s.face_count for s in relief)

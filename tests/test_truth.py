@@ -103,7 +103,7 @@ def test_the_truth_lifts_the_starts_the_reference_lifts():
     lengths = np.linalg.norm(receivers.lift, axis=1)
     receivers = receivers.subset((lengths > 2e-6) & (lengths < 2e-5))  # normalized: the drawn radius is 1
     assert 100 < len(receivers.points) < 2000
-    baker = ReferenceBaker(replace(plan, cells=np.unique(receivers.texel)), receivers)
+    baker = ReferenceBaker(plan.with_cells(np.unique(receivers.texel)), receivers)
     for index in range(len(plan.directions)):
         baker.run_direction(index)
     numerator, w = (part.reshape(-1)[receivers.texel] for part in plan.estimator.ratio(baker.accumulated()))

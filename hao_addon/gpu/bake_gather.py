@@ -73,8 +73,7 @@ GPU_TEXEL_LIST = True
 
 def cpu_receivers(plan: BakePlan) -> Receivers | None:
     """The receivers the gather uploads, or None where its GPU raster lists them."""
-    if (plan.projected is None and plan.vertex_target is None and plan.udim is None and plan.settings.sample_count == 1
-            and plan.cells is None and GPU_TEXEL_LIST):
+    if plan.layout.gpu_lists_receivers and plan.cells is None and GPU_TEXEL_LIST:
         return None
     return plan.receivers()
 
@@ -89,7 +88,7 @@ def views_per_dispatch(plan: BakePlan) -> int:
     if plan.layered:
         return 1
     most = int(np.clip(DEPTH_BATCH_BYTES // (4 * plan.max_view_side**2), 1, VIEWS_PER_DISPATCH))
-    directions = max(1, plan.settings.directions)
+    directions = max(1, plan.direction_count)
     batches = math.ceil(directions / most)
     return math.ceil(directions / batches)
 
@@ -380,7 +379,7 @@ class GatherBaker(LightViewBaker):
                 depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing,
                               positions_only=True, alpha=alpha)
         self.pending.append(view)
-        if len(self.pending) == self.slots or index == plan.settings.directions - 1:
+        if len(self.pending) == self.slots or index == plan.direction_count - 1:
             self._test_pending_views()
         self.stats["view_pixels"] += view.width * view.height
         self.stats["directions_done"] += 1

@@ -122,7 +122,7 @@ class ScatterBaker(LightViewBaker):
         plan = self.plan
         cells = np.asarray(cells, np.int64)
         face, bary = texel_area_points(plan.target_uvs, plan.settings.size, cells,
-                                       seed=(2 * plan.settings.seed + draw) % 2**31, points=AREA_POINTS)
+                                       seed=(2 * plan.seed + draw) % 2**31, points=AREA_POINTS)
         found = face >= 0
         return receivers_at(plan.target_positions, plan.target_faces, plan.target_corners,
                             np.repeat(cells, AREA_POINTS)[found.ravel()], face[found], bary[found],
@@ -161,8 +161,8 @@ class ScatterBaker(LightViewBaker):
         self.splat_prog = splat_shader(settings.weighting == "uniform", self.layered,
                                        plan.layered_falloff == "wendland", plan.needs_footprint_splat,
                                        plan.smooth_shading, settings.spread_cos)
-        self.chunk = min(CHUNK_DIRECTIONS, settings.directions)
-        self.fixed_scale = float(CHUNK_TARGET * settings.directions / (4.0 * self.chunk))
+        self.chunk = min(CHUNK_DIRECTIONS, plan.direction_count)
+        self.fixed_scale = float(CHUNK_TARGET * plan.direction_count / (4.0 * self.chunk))
         self.num = np.zeros((size, size), dtype=np.float64)
         self.den = np.zeros((size, size), dtype=np.float64)
         self.pending = 0

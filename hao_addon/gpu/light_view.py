@@ -312,7 +312,7 @@ class LightViewBaker(util.GPUPass):
         self.plan = plan
         self._views: dict[int, OrthoView] = {}
         # Direction of each step (run_direction(step)); subclasses may reorder.
-        self.direction_order = np.arange(plan.settings.directions)
+        self.direction_order = np.arange(plan.direction_count)
         self.alpha_pass = None
         try:
             order = self._draw_order()
@@ -353,7 +353,7 @@ class LightViewBaker(util.GPUPass):
         VIEW_PREFETCH steps at a time (plan.views): per view, numpy's call overhead was most
         of the fit's 0.5 ms on the bunny."""
         if step not in self._views:
-            steps = list(range(step, min(step + VIEW_PREFETCH, self.plan.settings.directions)))
+            steps = list(range(step, min(step + VIEW_PREFETCH, self.plan.direction_count)))
             fitted = self.plan.views([int(self.direction_order[s]) for s in steps])
             self._views = dict(zip(steps, fitted))
             self._views_fitted(steps, fitted)

@@ -7,7 +7,7 @@ pixel size from the texel density of the UV layout.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Generator
 
 import numpy as np
@@ -21,26 +21,34 @@ from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from ..steps import drain
-from .projection import HighToLow, RayCast, check_high_to_low, projected_receivers_steps
-from .receivers import Receivers, corner_receivers, uv_receivers
+from .projection import HighToLow, RayCast, check_high_to_low
+from .receivers import Receivers
+from .bake_run import BakeRun
 from .settings import BakeSettings
+from .target_layouts import LAYOUTS, TexelLayout
 from .uv_checks import tile_layout_warnings
 from .udim import UdimLayout, udim_layout
 from .target_kinds import TARGET_KINDS, TargetKind
 from .targets import BakeTarget, as_bake_target
 from .vertex_target import VertexTarget
 from .view_size import DENSE_AREA_LIMIT, light_pixel_size
-from .views import OrthoView, cell_corners, fit_views
-
-# Selected-to-Active light views are fitted to the corners of grid cells this many light-view
-# pixels wide that hold receivers (views.cell_corners): a few thousand points instead of
-# millions, for windows at most that much wider.
-VIEW_FIT_CELL = 16
+from .views import OrthoView, fit_views
 
 
 @dataclass
 class BakePlan:
+    """Everything the bakers read of one bake, made by make_plan_steps (built by keyword)."""
+
     settings: BakeSettings
+    # What this run bakes beside the settings (core/bake/bake_run.py): its directions' count
+    # and seed, the cells, whether AO alone.
+    run: BakeRun
+    # The target kind's part (core/bake/target_layouts.py): its receivers, the shape of its
+    # output and how sums become it.
+    layout: TexelLayout
+    # The bake method that runs: chosen once, here (abilities.choose_method of what the bake
+    # needs), and carried forward by the baker factory and the result (BakeResult.method).
+    method: str
     centre: np.ndarray            # (3,) float64, world
     scale: float                  # world units per normalized unit
     target_positions: np.ndarray  # (Ft, 3, 3) float32 normalized
@@ -69,58 +77,57 @@ class BakePlan:
     # (core/geometry.surface_holes; [] when closed); None when not, or not needed (a max
     # distance or ignored back faces change what a depth map must hold).
     holes: list[np.ndarray] | None = None
-    # Selected to Active: the high-poly points the target's texels project to
-    # (core/bake/projection.py); the target itself is then neither a receiver nor drawn.
-    projected: Receivers | None = None
-    # The colour-attribute target (core/bake/vertex_target.py): receivers at the target's
-    # face corners, summed per vertex or corner instead of per texel.
-    vertex_target: VertexTarget | None = None
-    # The UDIM tiles of a tiled UV layout (core/bake/udim.py): one map per tile.
-    udim: UdimLayout | None = None
     stats: dict = field(default_factory=dict)
-    # The target's kind (core/bake/target_kinds.py): texels, corners or projected points.
-    kind: TargetKind = TARGET_KINDS["texels"]
     # What lets light through, per drawn face (core/bake/alpha.py), or None: all opaque.
     alpha: DrawnAlpha | None = None
-    # Selected to Active: the projection's (receivers, stats, warning), which no direction or
-    # seed changes: the rounds of a bake to an error pass it on (make_plan_steps' projection).
-    projection: tuple | None = None
-    # The output cells (flat indices into output_shape) still to bake, or None for all: the
-    # later rounds of a bake to an error leave converged texels out, a verification bakes
-    # its sample. Receivers elsewhere are dropped (bakers that can: abilities.bakes_all_cells).
-    cells: np.ndarray | None = None
-    # The bake method that runs: chosen once, here (abilities.choose_method of what the bake
-    # needs), and carried forward by the baker factory and the result (BakeResult.method).
-    method: str = ""
+
+    @property
+    def kind(self) -> TargetKind:
+        """The target's kind (core/bake/target_kinds.py): texels, corners or projected points."""
+        return TARGET_KINDS[self.layout.KIND]
+
+    @property
+    def udim(self) -> UdimLayout | None:
+        """The UDIM tiles of a tiled UV layout (core/bake/udim.py): one map per tile."""
+        return self.layout.udim
+
+    @property
+    def cells(self) -> np.ndarray | None:
+        """The output cells (flat indices into output_shape) still to bake, or None for all:
+        the later rounds of a bake to an error leave converged texels out, a verification
+        bakes its sample. Receivers elsewhere are dropped (bakers that can: abilities.bakes_all_cells)."""
+        return self.run.cells
+
+    def with_cells(self, cells: np.ndarray | None) -> "BakePlan":
+        """This plan baking `cells` alone (None: all)."""
+        return replace(self, run=self.run.with_cells(cells))
+
+    @property
+    def seed(self) -> int:
+        """The run's seed: the light views' jitter, the passes' own random draws."""
+        return self.run.seed
+
+    @property
+    def direction_count(self) -> int:
+        return len(self.directions)
 
     def receivers(self) -> Receivers:
-        """The bake's receivers: the projected high-poly points, the target's face corners
-        (colour attributes), or the sample points of the target's own UV layout
-        (samples_per_texel of them per texel)."""
-        if self.projected is not None:
-            receivers = self.projected
-        elif self.vertex_target is not None:
-            receivers = corner_receivers(self.target_faces, self.target_positions, self.target_corners,
-                                         self.vertex_target.cells, self.lifts_terminator)
-        else:
-            receivers = uv_receivers(self.target_positions, self.target_uvs, self.target_faces, self.target_corners,
-                                     self.settings.size, self.settings.sample_count, self.lifts_terminator, self.udim)
+        """The bake's receivers (its layout's: the projected high-poly points, the target's
+        face corners, or the sample points of its own UV layout), those of `cells` alone
+        where the run names them."""
+        receivers = self.layout.receivers(self)
         return receivers if self.cells is None else receivers.subset(np.isin(receivers.texel, self.cells))
 
     @property
     def output_shape(self) -> tuple[int, ...]:
         """The shape of the bake's output elements: (size, size) texels, (tiles, size, size)
         of a UDIM layout, or (count,) vertices or corners of a colour-attribute target."""
-        if self.vertex_target is not None:
-            return (self.vertex_target.count,)
-        if self.udim is not None:
-            return (self.udim.count, self.settings.size, self.settings.size)
-        return (self.settings.size, self.settings.size)
+        return self.layout.output_shape
 
     @property
     def abilities_needed(self) -> frozenset[str]:
         """What a baker must be able to bake for this plan (core/bake/abilities.py)."""
-        needs = _needs(self.settings, self.kind, self.udim)
+        needs = _needs(self.settings, self.run, self.kind, self.udim)
         return needs | {"alpha"} if self.alpha is not None else needs
 
     def check_method(self, method: str) -> None:
@@ -206,7 +213,7 @@ class BakePlan:
         omegas = self.directions[list(indices)]
         c, r = self.drawn_sphere
         reaches = [float(omega @ c) + r for omega in omegas]
-        jitters = np.array([pixel_jitter(self.settings.seed, i) for i in indices]).reshape(-1, 2)
+        jitters = np.array([pixel_jitter(self.seed, i) for i in indices]).reshape(-1, 2)
         return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side)
 
 
@@ -238,72 +245,68 @@ def _check_finite(soup: TriangleSoup) -> None:
 
 def make_plan(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
               high_to_low: HighToLow | None = None, cast: RayCast | None = None,
-              vertex_target: VertexTarget | None = None) -> BakePlan:
+              vertex_target: VertexTarget | None = None, run: BakeRun | None = None) -> BakePlan:
     """Prepare a bake of `target` (which must carry UVs) against itself plus `occluders`, or,
     with `high_to_low`, of its sources projected onto its UVs (Selected to Active: the sources
     and the occluders occlude, the target does not), its rays cast by `cast` (default the
     CPU's, projection.project_steps); or, with `vertex_target` (settings.target
     'color-attribute'), at its face corners, UVs not needed. target may be a BakeTarget
-    (core/bake/targets.py) instead, which holds high_to_low or vertex_target itself."""
-    return drain(make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target))
+    (core/bake/targets.py) instead, which holds high_to_low or vertex_target itself. run: what
+    this run bakes beside the settings (core/bake/bake_run.py; default BakeRun.of(settings))."""
+    return drain(make_plan_steps(target, occluders, settings, high_to_low, cast, vertex_target, run=run))
 
 
 def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings,
                     high_to_low: HighToLow | None = None, cast: RayCast | None = None,
                     vertex_target: VertexTarget | None = None, projection: tuple | None = None,
-                    cells: np.ndarray | None = None, cast_for: Callable[[str], RayCast | None] | None = None
+                    run: BakeRun | None = None, cast_for: Callable[[str], RayCast | None] | None = None
                     ) -> Generator[float, None, BakePlan]:
     """make_plan(), yielding the fraction of the Selected-to-Active projection done (nothing
     without high_to_low): its seconds of ray casting can be drawn and cancelled. projection:
-    an earlier plan's (BakePlan.projection) of the same target, sources and settings but for
-    directions and seed, used instead of casting again. cells: BakePlan.cells. cast_for: the
-    chosen method's ray cast (cast, where not given)."""
+    an earlier plan's (BakePlan.reusable) of the same target, sources and settings but for
+    the run, used instead of casting again. cast_for: the chosen method's ray cast (cast,
+    where not given)."""
     settings = settings.validated()
+    run = BakeRun.of(settings) if run is None else run
     bake_target, occluders = _checked_inputs(target, occluders, settings, high_to_low, vertex_target)
     kind, target = bake_target.kind, bake_target.soup
-    high_to_low, vertex_target = bake_target.high_to_low, bake_target.corners
     normals, areas = _face_normals_areas(target)
     uv_area, udim, uv_warnings, uv_counters = _uv_layout(target, kind, settings)
-    method = _checked_method(settings, kind, udim)  # before the projection's rays
-    if cast is None and cast_for is not None and high_to_low is not None:
+    method = _checked_method(settings, run, kind, udim)  # before the projection's rays
+    if cast is None and cast_for is not None and bake_target.high_to_low is not None:
         cast = cast_for(method)
-    flat = target.positions.reshape(-1, 3)
     centre, scale, t_pos = _normalized(target)
-    directions = bake_directions(settings.directions, settings.seed)
-
-    projection = yield from _projection(target, high_to_low, settings, centre, scale, cast, udim, projection)
-    projected, projection_stats, extent, warnings = _projected(projection)
-    uv_warnings = uv_warnings + warnings
-    if projected is not None and len(projected):
-        flat = np.concatenate([flat, projected.points * scale + centre])
+    directions = bake_directions(run.directions, run.seed)
+    # The kind's own steps (a Selected-to-Active projection casts its rays here).
+    layout = yield from LAYOUTS[kind.name].made(bake_target, settings, udim, centre, scale, cast, projection)
+    flat = np.concatenate([target.positions.reshape(-1, 3), layout.receiver_points() * scale + centre])
     o_pos, alpha_parts, culling = _drawn_occluders(occluders, flat, settings, kind, target, centre, scale)
     o_normals, _ = face_normals_areas(o_pos)
     inv_s = _inverse_normalizers(normals, areas, directions, settings)
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
-    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, extent)
+    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, layout.extent)
 
     drawn = np.concatenate(([t_pos.reshape(-1, 3)] if kind.target_occludes else []) + [o_pos.reshape(-1, 3)])
     target_weld = weld(t_pos.reshape(-1, 3))
     alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
     if alpha is not None:  # the bake needs occluders that let light through: Auto chooses again
-        method = choose_method(settings.method, _needs(settings, kind, udim) | {"alpha"})
+        method = choose_method(run.method, _needs(settings, run, kind, udim) | {"alpha"})
     holes = _drawn_holes(settings, alpha, drawn, target_weld if len(o_pos) == 0 else None)
-    # Distinct corners: a light view's window is fitted to them (shared corners once); in
-    # Selected to Active the corners of the grid cells that hold receivers (VIEW_FIT_CELL).
-    target_points = t_pos.reshape(-1, 3)[target_weld[0]] if projected is None else \
-        cell_corners(projected.points, VIEW_FIT_CELL * pixel_size)
     stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
-                        holes, smooth_corners, uv_warnings, alpha,
-                        {**uv_counters, **_layout_counters(udim, vertex_target), **projection_stats})
+                        holes, smooth_corners, uv_warnings + layout.warnings, alpha, {**uv_counters, **layout.counters})
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
-    return BakePlan(settings, centre, scale, t_pos.astype(np.float32), uvs.astype(np.float32),
-                    np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), corners, above,
-                    o_pos.astype(np.float32), np.asarray(o_normals, dtype=np.float32), directions,
-                    pixel_size, int(np.ceil(2.0 * extent / pixel_size)) + 4, target_points, bounding_sphere(drawn),
-                    dense_fraction > DENSE_AREA_LIMIT,
-                    smooth_corners > 0 or (projected is not None and projection_stats["smooth_receivers"] > 0),
-                    holes == [], holes, projected, vertex_target, udim, stats, kind, alpha, projection, cells,
-                    method)
+    return BakePlan(
+        settings=settings, run=run, layout=layout, method=method, centre=centre, scale=scale,
+        target_positions=t_pos.astype(np.float32), target_uvs=uvs.astype(np.float32),
+        target_faces=np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), target_corners=corners,
+        target_above=above, occluder_positions=o_pos.astype(np.float32),
+        occluder_normals=np.asarray(o_normals, dtype=np.float32), directions=directions, pixel_size=pixel_size,
+        max_view_side=int(np.ceil(2.0 * layout.extent / pixel_size)) + 4,
+        # Distinct corners: a light view's window is fitted to them (shared corners once).
+        target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
+        drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
+        smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
+        stats=stats, alpha=alpha)
 
 
 def _face_normals_areas(target: TriangleSoup) -> tuple[np.ndarray, np.ndarray]:
@@ -322,40 +325,26 @@ def _normalized(target: TriangleSoup) -> tuple[np.ndarray, float, np.ndarray]:
     return centre, scale, (target.positions - centre) / scale
 
 
-def _projection(target: TriangleSoup, high_to_low: HighToLow | None, settings: BakeSettings, centre: np.ndarray,
-                scale: float, cast: RayCast | None, udim: UdimLayout | None, earlier: tuple | None
-                ) -> Generator[float, None, tuple | None]:
-    """Selected to Active: the receivers are the sources' points the texels project to
-    (projected_receivers_steps; an earlier round's where given). None without high_to_low."""
-    if high_to_low is None or earlier is not None:
-        return earlier if high_to_low is not None else None
-    return (yield from projected_receivers_steps(target, high_to_low, settings, centre, scale, cast, udim))
-
-
-def _projected(projection: tuple | None) -> tuple:
-    """(the projected receivers or None, their stats, the receivers' sphere's radius about the
-    origin, normalized (1: the target's), the projection's warnings)."""
-    if projection is None:
-        return None, {}, 1.0, []
-    projected, stats, warning = projection
-    extent = max(1.0, float(np.linalg.norm(projected.points, axis=1).max())) if len(projected) else 1.0
-    return projected, stats, extent, [warning] if warning else []
-
-
-def _checked_method(settings: BakeSettings, kind, udim: UdimLayout | None) -> str:
-    """The method that bakes: settings.method, or Auto's choice for what the bake needs of a
+def _checked_method(settings: BakeSettings, run: BakeRun, kind, udim: UdimLayout | None) -> str:
+    """The method that bakes: the run's, or Auto's choice for what the bake needs of a
     baker; a method that cannot bake it is refused here."""
-    needs = _needs(settings, kind, udim)
-    method = choose_method(settings.method, needs)
+    needs = _needs(settings, run, kind, udim)
+    method = choose_method(run.method, needs)
     check_method(method, needs, asked_phrases(udim))
     return method
 
 
-def _needs(settings: BakeSettings, kind, udim: UdimLayout | None) -> frozenset[str]:
-    """What a bake with these settings, this target kind and (where tiled) UDIM layout needs
-    of a baker, occluders that let light through aside (BakePlan.abilities_needed adds them)."""
-    return abilities_needed(settings.max_distance, settings.bent_normals, kind, udim is not None,
-                            settings.min_distance, settings.spread_cos > 0.0)
+def _bent_normals(settings: BakeSettings, run: BakeRun) -> bool:
+    """Whether the run sums bent normals: the settings ask for them and it reads more than the AO."""
+    return settings.bent_normals and not run.ao_only
+
+
+def _needs(settings: BakeSettings, run: BakeRun, kind, udim: UdimLayout | None) -> frozenset[str]:
+    """What a bake with these settings, this run, this target kind and (where tiled) UDIM
+    layout needs of a baker, occluders that let light through aside (BakePlan.abilities_needed
+    adds them)."""
+    return run.needs | abilities_needed(settings.max_distance, _bent_normals(settings, run), kind, udim is not None,
+                                        settings.min_distance, settings.spread_cos > 0.0)
 
 
 def _inverse_normalizers(normals: np.ndarray, areas: np.ndarray, directions: np.ndarray,
@@ -434,16 +423,6 @@ def _drawn_occluders(occluders: list[TriangleSoup], flat: np.ndarray, settings: 
     culling = dict(occluder_faces_culled=culled_faces, occluder_objects_drawn=drawn_objects,
                    occluder_objects_culled=culled_objects)
     return o_pos, alpha_parts, culling
-
-
-def _layout_counters(udim: UdimLayout | None, vertex_target: VertexTarget | None) -> dict:
-    counters = {}
-    if udim is not None:
-        counters["udim_tiles"] = [int(t) for t in udim.tiles]
-    if vertex_target is not None:
-        counters.update(vertex_target_corners=int((vertex_target.cells >= 0).sum()),
-                        vertex_target_elements=vertex_target.count)
-    return counters
 
 
 def _plan_stats(target: TriangleSoup, settings: BakeSettings, areas: np.ndarray, uv_area: np.ndarray | None,

@@ -44,12 +44,8 @@ class ReferenceBaker:
     def rays_needed(plan: BakePlan) -> int:
         """Rays of a whole bake at most (one per receiver and direction)."""
         if plan.cells is not None:
-            return len(plan.cells) * plan.settings.sample_count * plan.settings.directions
-        if plan.projected is not None:
-            return len(plan.projected) * plan.settings.directions
-        if plan.vertex_target is not None:
-            return int((plan.vertex_target.cells >= 0).sum()) * plan.settings.directions
-        return plan.settings.size ** 2 * plan.settings.sample_count * plan.settings.directions
+            return len(plan.cells) * plan.settings.sample_count * plan.direction_count
+        return plan.layout.receiver_bound() * plan.direction_count
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:

@@ -11,8 +11,6 @@ from dataclasses import asdict, dataclass
 
 from ..kernels import FALLOFF_CHOICES
 from ..setting_spec import Choice, setting, validate
-from .abilities import abilities_needed, choose_method
-from .target_kinds import TARGET_KINDS, kind_name
 
 MAX_DIRECTIONS = 65536
 MAX_MAP_SIZE = 16384
@@ -178,19 +176,6 @@ class BakeSettings:
         """Return self, or raise SettingError / BakeInputError with a message a user can act on."""
         validate(self)
         return self
-
-    def method_for(self, high_to_low: bool, tiled: bool = False) -> str:
-        """The bake variant that runs: the Method, or for 'auto' the bakers' declared choice
-        (core/bake/abilities.py: the scatter with a max distance where it can bake the rest
-        of what is asked, otherwise the gather). high_to_low: Selected to Active; tiled: the
-        UV layout lies on UDIM tiles."""
-        return choose_method(self.method, self.abilities_needed(high_to_low, tiled))
-
-    def abilities_needed(self, high_to_low: bool, tiled: bool = False) -> frozenset[str]:
-        """What a baker must be able to bake for these settings (core/bake/abilities.py)."""
-        kind = TARGET_KINDS[kind_name(self.target, high_to_low)]
-        return abilities_needed(self.max_distance, self.bent_normals, kind, tiled, self.min_distance,
-                                self.spread_cos > 0.0)
 
     @property
     def error_target(self) -> float:
