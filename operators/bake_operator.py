@@ -135,7 +135,7 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
             self.report({'INFO'}, f"Baked AO of {len(job.request.frames)} frames into {files} files "
                                   f"({sum(e['reused'] for e in job.frame_results)} frames reused an earlier bake)")
             return
-        if job.request.to_color_attribute:
+        if not job.request.kind.writes_images:
             names = ", ".join(f"'{obj.name}'" for obj, _uv, _result in job.results)
             self.report({'INFO'}, f"Baked AO into the colour attribute '{AO_ATTRIBUTE}' of {names}{error_note(job)}")
             return

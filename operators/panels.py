@@ -9,6 +9,7 @@ import bpy
 
 from ..hao_addon.core.bake.map_kinds import EXTRA_MAPS
 from ..hao_addon.core.bake.settings import QUALITY_CAPS
+from ..hao_addon.core.bake.target_kinds import target_kind
 
 
 def _split_layout(layout):
@@ -55,8 +56,8 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         self.layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
         col = _split_layout(self.layout)
         col.prop(settings, "target")
-        if settings.target == "color-attribute":
-            col.prop(settings, "color_domain")
+        for name in target_kind(settings.target).settings:  # the Target's own settings (its row's)
+            col.prop(settings, name)
         _props(col, settings, "size", "occluders", "method")
 
 

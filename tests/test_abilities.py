@@ -18,6 +18,7 @@ from hao_addon.core.bake.projection import HighToLow
 from hao_addon.core.bake.settings import METHODS, BakeSettings
 from hao_addon.core.bake.vertex_target import indexed_vertex_target
 from hao_addon.core.errors import BakeInputError
+from hao_addon.core.steps import drain
 from hao_addon.core.geometry import TriangleSoup
 
 
@@ -143,3 +144,42 @@ def test_the_plan_chooses_the_method_once_and_the_result_carries_it(gpu_context,
                         raising=False)
     result = bake_module.bake(sphere, [], BakeSettings(size=32, directions=8, max_distance=0.5), use_cache=False)
     assert result.method == result.stats["method"] == "scatter" and len(calls) == 1
+
+
+def test_rounds_and_verification_take_their_run_as_a_value(gpu_context, monkeypatch):
+    """Issue 40 item 4: a bake to an error's rounds and a verification plan the user's settings
+    unchanged, each with its own BakeRun (directions, seed, method, cells); a thickness bake's
+    need of the thickness ability is its run's, and the plan alone chooses the method."""
+    from hao_addon import bake as bake_module
+    from hao_addon import verify as verify_module
+    from hao_addon.core.bake import plan as plan_module
+
+    planned = []
+    real = plan_module.make_plan_steps
+
+    def recorded(target, occluders, settings, *args, **kwargs):
+        planned.append((settings, kwargs.get("run")))
+        return real(target, occluders, settings, *args, **kwargs)
+
+    monkeypatch.setattr(bake_module, "make_plan_steps", recorded)
+    monkeypatch.setattr(verify_module, "make_plan_steps", recorded)
+    sphere, floor = scenes.uv_sphere(0.6, (0.0, 0.0, 0.6), 16, 8), scenes.grid_plane(4.0, 4, name="floor")
+    settings = BakeSettings(size=32, directions=4096, max_error=0.05, seed=3)
+    result = bake_module.bake(floor, [sphere], settings, use_cache=False)
+    assert len(planned) == len(result.stats["rounds"]) > 1
+    assert all(s == settings.validated() for s, _run in planned)  # never rewritten
+    runs = [run for _s, run in planned]
+    assert [r.directions for r in runs] == result.stats["rounds"] and len({r.seed for r in runs}) == len(runs)
+    assert runs[0].seed == settings.seed and {r.method for r in runs} == {"auto"}
+
+    planned.clear()
+    verification = drain(verify_module.verify_steps(floor, [sphere], settings, result, 16))
+    assert verification is not None and len(planned) == 1
+    (s, run), = planned
+    assert s == settings and run.method == "reference" and run.ao_only and len(run.cells) == 16
+
+    planned.clear()
+    thickness = drain(bake_module.thickness_steps(sphere, BakeSettings(size=32, directions=16, thickness=True),
+                                                  use_cache=False))
+    (s, run), = planned
+    assert run.needs == frozenset({"thickness"}) and thickness.method == "scatter"

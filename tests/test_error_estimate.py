@@ -212,7 +212,7 @@ def test_every_target_bakes_to_a_stated_error(gpu_context, monkeypatch, target, 
     """A sphere over a floor to a p99 of 0.03 on every target kind and method that can bake it:
     more than one round, the estimate within the target and not capped. Selected to Active
     casts its projection once for all rounds (the rounds differ only in their directions)."""
-    import hao_addon.core.bake.plan as plan_module
+    import hao_addon.core.bake.target_layouts as plan_module  # the projected kind casts its rays there
     from hao_addon.core.bake.projection import HighToLow
     from hao_addon.core.bake.vertex_target import indexed_vertex_target
     casts = []
@@ -269,7 +269,7 @@ def test_rounds_can_leave_converged_texels_out(gpu_context, monkeypatch, method)
     """With SKIP_CONVERGED on (the benchmark's comparison), a round after the pilot bakes only
     the texels not yet converged: fewer receivers traced or listed (counted)."""
     import hao_addon.bake as bake_module
-    import hao_addon.core.bake.plan as plan_module
+    import hao_addon.core.bake.target_layouts as plan_module  # the projected kind casts its rays there
     monkeypatch.setattr(bake_module, "SKIP_CONVERGED", True)
     listed = []
     original = plan_module.BakePlan.receivers

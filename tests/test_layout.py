@@ -94,3 +94,34 @@ def test_no_product_file_or_function_is_too_long_to_read(tmp_path):
     long = tmp_path / "long.py"
     long.write_text("def f():\n" + "    x = 1\n" * 59 + "    return x\n", encoding="utf-8")
     assert oversized([long]) == [f"{long}:1 f: 61 lines"]
+
+
+def kind_literals(paths) -> list[str]:
+    """Where `paths` compare or spell a target kind or the Target setting's values as strings
+    in code (docstrings and comments aside)."""
+    import ast
+    from hao_addon.core.bake.target_kinds import TARGET_KINDS
+    words = {*TARGET_KINDS, *(kind.target for kind in TARGET_KINDS.values() if kind.target != "image")}
+    found = []
+    for path in paths:
+        tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+        docstrings = {id(node.body[0].value) for node in ast.walk(tree)
+                      if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef)) and node.body
+                      and isinstance(node.body[0], ast.Expr) and isinstance(node.body[0].value, ast.Constant)}
+        found += [f"{path}:{node.lineno} {node.value!r}" for node in ast.walk(tree)
+                  if isinstance(node, ast.Constant) and node.value in words and id(node) not in docstrings]
+    return found
+
+
+def test_only_the_core_names_the_target_kinds(tmp_path):
+    """Issue 40 item 3: the Blender layer, the GPU passes, the CLI and the operators read the
+    kind's row (core/bake/target_kinds.py: writes_images, needs_uvs, its settings) and its
+    plan's layout (core/bake/target_layouts.py), never its name or the Target's value as a
+    string; a check like the ones they replaced is caught."""
+    above = [p for folder in ("blender", "gpu", "cli") for p in (ROOT / "hao_addon" / folder).rglob("*.py")]
+    above += [*(ROOT / "operators").rglob("*.py"), *(ROOT / "hao_addon").glob("*.py")]
+    assert kind_literals(above) == []
+    check = tmp_path / "check.py"
+    check.write_text('def f(settings):\n    """color-attribute"""\n    return settings.target == "color-attribute"\n',
+                     encoding="utf-8")
+    assert kind_literals([check]) == [f"{check}:3 'color-attribute'"]

@@ -170,7 +170,7 @@ class BakeJob:
         req = self.request
         uv_names = {}
         for obj in req.targets:  # a colour attribute needs no UV map
-            uv_names[obj.name] = "" if req.to_color_attribute else (yield from self._uv_name_for(obj))
+            uv_names[obj.name] = (yield from self._uv_name_for(obj)) if req.kind.needs_uvs else ""
         if not req.frames:
             yield from self._bake_frame(uv_names, 0.0, 1.0)
             self.finished = True
@@ -217,7 +217,7 @@ class BakeJob:
                                           shading_normals=req.settings.normals == "mesh") for o in unit.objects]
         soup = texture_set_target(parts, req.settings.size, unit.label) if req.options.texture_set else parts[0]
         corners = None
-        if req.to_color_attribute:
+        if not req.kind.writes_images:  # one value per mesh element: its vertices or face corners
             corners = mesh_data.color_attribute_target(unit.objects[0], depsgraph, req.settings.color_domain)
         high_to_low = self._high_to_low(unit.objects[0], depsgraph, unit.sources) if unit.sources is not None else None
         target = BakeTarget.of(soup, req.settings.target, high_to_low, corners)
@@ -323,7 +323,7 @@ class BakeJob:
         if not self.finished:
             raise RuntimeError("commit() before the bake finished")
         req = self.request
-        if req.to_color_attribute:
+        if not req.kind.writes_images:
             for obj, _uv, result in self.results:
                 color_attributes.store_color_attribute(obj.data, result.ao, req.settings.color_domain)
             return self.committed

@@ -15,11 +15,13 @@ from .. import compat
 from ..core.bake.job_options import JobOptions
 from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 from ..core.bake.settings import BakeSettings
+from ..core.bake.target_kinds import TargetKind, target_kind
 from ..core.bake.udim import tile_path
 from ..core.errors import BakeInputError
 from ..core.file_checks import image_is_whole, output_is_whole
 from ..core.imageio import BAKE_KEY, FORMATS, check_writable, read_text
 from ..core.output_files import check_output_files, frame_file, with_token
+from ..core.setting_spec import specs
 from .paths import FRAME_TOKEN, OBJECT_TOKEN, absolute_path, example_path, object_file_name
 
 # What a texture set's image and files are named after (JobOptions.texture_set).
@@ -93,10 +95,12 @@ class BakeRequest:
     file_text: dict = field(default_factory=dict)
 
     @property
-    def to_color_attribute(self) -> bool:
-        """settings.target 'color-attribute': AO into each target's colour attribute hao_ao
-        (blender/color_attributes.py), no UV map, image or file."""
-        return self.settings.target == "color-attribute"
+    def kind(self) -> TargetKind:
+        """The targets' kind (core/bake/target_kinds.py), from the Target setting and Selected to
+        Active (high-poly meshes, or bake groups with some): images of the UV layout, or (a
+        colour attribute, hao_ao: blender/color_attributes.py) one value per mesh element,
+        no UV map, image or file."""
+        return target_kind(self.settings.target, self.high_poly is not None or any(g.highs for g in self.groups or ()))
 
     def map_path(self, key: str) -> str:
         """The file pattern of the map `key` (core/bake/map_kinds.py), '' when it is not written."""
@@ -145,14 +149,14 @@ def validate_request(request: BakeRequest) -> None:
         raise BakeInputError("a cage object is used only with Selected to Active")
     if not request.targets:
         raise BakeInputError("no mesh selected: select one or more mesh objects to bake")
-    if request.to_color_attribute:
-        _validate_color_attribute(request)
+    if not request.kind.writes_images:
+        _validate_element_target(request)
     for obj in request.targets:
         if obj.type != 'MESH':
             raise BakeInputError(f"'{obj.name}' is not a mesh")
         if len(obj.data.polygons) == 0:
             raise BakeInputError(f"'{obj.name}' has no faces to bake")
-        if request.to_color_attribute:
+        if not request.kind.needs_uvs:
             continue
         name = request.uv_map
         if name not in ("", "AUTO") and name not in obj.data.uv_layers:
@@ -166,26 +170,7 @@ def validate_request(request: BakeRequest) -> None:
         _validate_texture_set(request)
     elif request.image is not None and len(request.targets) > 1:
         raise BakeInputError("an existing image can receive only one object's bake (or bake them as a texture set)")
-    unknown = sorted(set(request.map_paths) - {kind.key for kind in EXTRA_MAPS})
-    if unknown:
-        raise BakeInputError(f"no map '{unknown[0]}' to write: the maps are {', '.join(k.key for k in EXTRA_MAPS)}")
-    if request.map_path("bent") and not request.settings.bent_normals:
-        raise BakeInputError("a bent-normal file needs the Bent Normals setting on")
-    if request.map_path("orm") and (request.to_color_attribute or request.options.texture_set):
-        raise BakeInputError("the ORM texture packs one object's AO with its material (not a colour attribute or a "
-                             "texture set)")
-    surface_maps = [kind for kind in EXTRA_MAPS if kind.from_surface is not None and request.map_path(kind.key)]
-    if surface_maps and request.to_color_attribute:
-        raise BakeInputError(f"{surface_maps[0].noun} is an image of the UV layout, not a colour attribute")
-    if request.map_path("error") and request.to_color_attribute:
-        raise BakeInputError("an error map is an image of the UV layout: a colour-attribute bake reports its error "
-                             "(--json) but has no error map")
-    if request.map_path("thickness") and not request.settings.thickness:
-        raise BakeInputError("a thickness file needs the Thickness setting on")
-    if request.settings.thickness and (request.to_color_attribute or request.high_poly is not None
-                                       or any(g.highs for g in request.groups or ())):
-        raise BakeInputError("thickness bakes the mesh's own surface into an image (not a colour attribute or "
-                             "Selected to Active)")
+    _validate_maps(request)
     size = request.settings.size
     for obj in file_owners(request):
         for _kind, filepath, _what, channels in output_kinds(request):
@@ -269,17 +254,35 @@ def input_files(request: BakeRequest) -> list[tuple[str, str]]:
     return source + scene_image_files() + [tuple(entry) for entry in request.extra_inputs]
 
 
+def _validate_maps(request: BakeRequest) -> None:
+    """Each map asked for (its file, or its setting) by a kind of target that can make it (the
+    map rows' target_kinds, core/bake/map_kinds.py), and each file with the setting it needs on."""
+    unknown = sorted(set(request.map_paths) - {kind.key for kind in EXTRA_MAPS})
+    if unknown:
+        raise BakeInputError(f"no map '{unknown[0]}' to write: the maps are {', '.join(k.key for k in EXTRA_MAPS)}")
+    labels = {f.name: spec.label for f, spec in specs(BakeSettings)}
+    for row in MAP_KINDS:
+        if row.setting and request.map_path(row.key) and not getattr(request.settings, row.setting):
+            raise BakeInputError(f"{row.panel_label} ({row.noun}) needs the {labels[row.setting]} setting on")
+    for row in MAP_KINDS:
+        asked = request.map_path(row.key) or (row.setting and getattr(request.settings, row.setting))
+        if asked and request.kind.name not in row.target_kinds:
+            raise BakeInputError(row.refusal)
+    if request.map_path("orm") and request.options.texture_set:
+        raise BakeInputError("the ORM texture packs one object's AO with its material (not a texture set)")
+
+
 def _validate_frames(request: BakeRequest) -> None:
     if not request.frames:
         raise BakeInputError("a frame sequence needs at least one frame")
-    if request.to_color_attribute:
+    if not request.kind.writes_images:
         raise BakeInputError("a colour attribute holds one frame: bake a frame sequence into image files")
     if not request.filepath:
         raise BakeInputError("a frame sequence writes one file per frame: set Save To (a path with {frame})")
 
 
 def _validate_texture_set(request: BakeRequest) -> None:
-    if request.to_color_attribute or request.high_poly is not None:
+    if request.high_poly is not None or not request.kind.writes_images:
         raise BakeInputError("a texture set bakes the objects' own surfaces into one image: not with a colour "
                              "attribute or Selected to Active")
     for obj in request.targets:
@@ -291,10 +294,12 @@ def _validate_texture_set(request: BakeRequest) -> None:
                              "tangent space")
 
 
-def _validate_color_attribute(request: BakeRequest) -> None:
-    if request.high_poly is not None or request.settings.bent_normals:
-        raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active and "
-                             "bent normals bake into images (Target: Image Textures)")
+def _validate_element_target(request: BakeRequest) -> None:
+    """A target kind of one value per mesh element (a colour attribute): the mesh's own
+    surface, and no image or file."""
+    if request.high_poly is not None:
+        raise BakeInputError("a colour attribute holds the AO of the mesh's own surface: Selected to Active bakes "
+                             "into images (Target: Image Textures)")
     if request.filepath or request.image is not None:
         raise BakeInputError("a colour-attribute bake writes no image: clear the image and the file path, or "
                              "bake to Image Textures")
@@ -303,7 +308,7 @@ def _validate_color_attribute(request: BakeRequest) -> None:
 def _validate_groups(request: BakeRequest) -> None:
     if request.high_poly is not None or request.cage is not None:
         raise BakeInputError("bake groups find their high-poly meshes by name: no separate high-poly or cage")
-    if request.to_color_attribute:
+    if not request.kind.writes_images:
         raise BakeInputError("bake groups bake each low-poly into an image (not a colour attribute)")
     if request.options.texture_set and (request.settings.bent_normals or request.settings.thickness
                                         or request.map_path("orm") or request.frames):

@@ -14,6 +14,7 @@ from .parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
 from .scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
                         export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
 from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
+from ..core.bake.target_kinds import target_kind
 from ..core.frame_ranges import parse_frames
 from ..core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
 from ..core.setting_spec import SettingError
@@ -38,7 +39,8 @@ class _Run:
 
     @property
     def to_colors(self) -> bool:
-        return self.settings.target == "color-attribute"
+        """The bake writes one value per mesh element (a colour attribute), no image."""
+        return not target_kind(self.settings.target).writes_images
 
 
 def run_bake(args, report: Report, progress: Progress) -> list[str]:
@@ -86,9 +88,11 @@ def _checked_run(args, report: Report) -> _Run:
     first_frame = frames[0] if frames else 0
     if source.suffix.lower() != ".blend":  # imported objects carry no terminator offset of their own
         settings = replace(settings, terminator="setting")
-    to_colors = settings.target == "color-attribute"
-    if to_colors and (args.gltf_out or any(getattr(args, option) for option in IMAGE_OPTIONS)):
-        options = ", ".join("--" + option.replace("_", "-") for option in IMAGE_OPTIONS)
+    kind = target_kind(settings.target)
+    to_colors = not kind.writes_images
+    images = [row.option for row in EXTRA_MAPS if kind.name not in row.target_kinds]  # the maps its kind lacks
+    if to_colors and (args.gltf_out or any(getattr(args, option) for option in images)):
+        options = ", ".join("--" + option.replace("_", "-") for option in images)
         raise CLIError("--target color-attribute writes the mesh with its colour attribute to --out (.blend, .glb "
                        f"or .ply); {options} and --gltf-out are image bakes")
     for kind in EXTRA_MAPS:
@@ -357,7 +361,9 @@ def fill_input_token(args, path: str) -> None:
 
 
 def to_colors(args) -> bool:
-    return getattr(args, "target", None) == "color-attribute"
+    """The command bakes one value per mesh element (--target color-attribute), no image."""
+    target = getattr(args, "target", None)
+    return target is not None and not target_kind(target).writes_images
 
 
 def start_gpu() -> None:

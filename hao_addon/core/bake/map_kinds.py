@@ -10,6 +10,7 @@ from typing import Callable
 import numpy as np
 
 from .curvature import cavity_map, curvature_map
+from .target_kinds import TARGET_KINDS
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,10 @@ class MapKind:
     # Made from the target's own surface alone: (soup, size, margin) -> (size, size) map (no AO
     # result needed; the bake job calls it for each target). None: the job's own producer.
     from_surface: Callable[..., np.ndarray] | None = None
+    # The target kinds (core/bake/target_kinds.py) that can make it, and the refusal where
+    # another is asked for it.
+    target_kinds: frozenset[str] = frozenset(TARGET_KINDS)
+    refusal: str = ""
 
     @property
     def option(self) -> str:
@@ -52,29 +57,42 @@ class MapKind:
         return f"{self.noun} ({self.flag})"
 
 
+# The target kinds whose output is images of the UV layout.
+IMAGE_KINDS = frozenset(kind.name for kind in TARGET_KINDS.values() if kind.writes_images)
+
 MAP_KINDS = (
     MapKind("ao", "ao", "the AO map", 1, "", "", "Save To",
             "the ambient occlusion, 1 open to 0 occluded", image_suffix="AO"),
     MapKind("bent-normal", "bent", "the bent normals", 4, "bent_normals", "bent_normals_file", "Save Bent Normals To",
             "the bent normals (the cosine-weighted mean unoccluded direction, same pass), RGB 0.5 + 0.5 n",
-            image_suffix="BentNormals", settings=("bent_space", "bent_convention")),
+            image_suffix="BentNormals", settings=("bent_space", "bent_convention"), target_kinds=IMAGE_KINDS,
+            refusal="a colour attribute holds the AO of the mesh's own surface: bent normals bake into images "
+                    "(Target: Image Textures)"),
     MapKind("thickness", "thickness", "the thickness map", 1, "thickness", "thickness_file", "Save Thickness To",
             "thickness: the occlusion of the inverted hemisphere by the mesh itself within the thickness "
             "distance, 1 thin, 0 nothing within reach (a second pass)", image_suffix="Thickness",
-            settings=("thickness_distance",)),
+            settings=("thickness_distance",), target_kinds=frozenset({"texels"}),
+            refusal="thickness bakes the mesh's own surface into an image (not a colour attribute or Selected to "
+                    "Active)"),
     MapKind("orm", "orm", "the ORM texture", 4, "", "orm_file", "Save ORM To",
             "glTF's occlusion-roughness-metallic texture: R the AO, G and B the material's roughness and "
             "metallic (values or image textures) in the baked UV layout",
-            "with --gltf-out the .glb's material uses it for occlusion, roughness and metallic", image_suffix="ORM"),
+            "with --gltf-out the .glb's material uses it for occlusion, roughness and metallic", image_suffix="ORM",
+            target_kinds=IMAGE_KINDS, refusal="the ORM texture packs one object's AO with its material (not a colour "
+                                              "attribute)"),
     MapKind("error", "error", "the error map", 1, "", "error_file", "Save Error To",
             "each texel's estimated error (the RMS of the bake's own error estimate over its 5 x 5 "
-            "neighbourhood: one standard error)"),
+            "neighbourhood: one standard error)", target_kinds=IMAGE_KINDS,
+            refusal="an error map is an image of the UV layout: a colour-attribute bake reports its error (--json) "
+                    "but has no error map"),
     MapKind("curvature", "curvature", "the curvature map", 1, "", "curvature_file", "Save Curvature To",
             "the surface's mean curvature times its bounding radius, 0.5 flat, brighter convex, darker concave",
-            image_suffix="Curvature", from_surface=curvature_map),
+            image_suffix="Curvature", from_surface=curvature_map, target_kinds=IMAGE_KINDS,
+            refusal="the curvature map is an image of the UV layout, not a colour attribute"),
     MapKind("cavity", "cavity", "the cavity map", 1, "", "cavity_file", "Save Cavity To",
             "cavities: 1 on flat and convex surface, darker in grooves and crevices", image_suffix="Cavity",
-            from_surface=cavity_map),
+            from_surface=cavity_map, target_kinds=IMAGE_KINDS,
+            refusal="the cavity map is an image of the UV layout, not a colour attribute"),
 )
 # The maps besides the AO, each with a file option of its own.
 EXTRA_MAPS = MAP_KINDS[1:]
