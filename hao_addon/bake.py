@@ -32,6 +32,7 @@ from .core.bake.settings import QUALITY_CAPS, BakeSettings
 from .core.bake.abilities import declaration
 from .core.bake.bake_run import BakeRun
 from .core.bake.targets import BakeTarget, as_bake_target
+from .core.bake.target_kinds import IMAGE_TARGET
 from .core.bake.vertex_target import VertexTarget
 
 
@@ -435,7 +436,8 @@ def thickness_steps(target: TriangleSoup, settings: BakeSettings, use_cache: boo
         distance = float(bounding_sphere(target.positions.reshape(-1, 3))[1])
     # The AO bake of the inverted soup within the distance: a bake of its own (its own cache
     # key), whose baker must be able to bake thickness (core/bake/abilities.py: the plan chooses).
-    inside = replace(settings, max_distance=distance, bent_normals=False, thickness=False, target="image")
+    inside = replace(settings, max_distance=distance, bent_normals=False, thickness=False,
+                     target=IMAGE_TARGET)
     # About the true (flat) inverted surface: with shading normals, directions below a face
     # but inside the smooth hemisphere count as occluded at distance 0 (Cycles' AO convention:
     # the ray enters the surface), which for thickness is the ray leaving the mesh; they gave

@@ -101,15 +101,20 @@ def kind_literals(paths) -> list[str]:
     in code (docstrings and comments aside)."""
     import ast
     from hao_addon.core.bake.target_kinds import TARGET_KINDS
-    words = {*TARGET_KINDS, *(kind.target for kind in TARGET_KINDS.values() if kind.target != "image")}
+    kinds = set(TARGET_KINDS)
+    targets = {kind.target for kind in TARGET_KINDS.values()}  # 'image' also names other things: compared
     found = []
     for path in paths:
         tree = ast.parse(Path(path).read_text(encoding="utf-8"))
         docstrings = {id(node.body[0].value) for node in ast.walk(tree)
                       if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef)) and node.body
                       and isinstance(node.body[0], ast.Expr) and isinstance(node.body[0].value, ast.Constant)}
+        compared = {id(c) for node in ast.walk(tree) if isinstance(node, ast.Compare)
+                    for c in (node.left, *node.comparators)}
+        compared |= {id(node.value) for node in ast.walk(tree) if isinstance(node, ast.keyword) and node.arg == "target"}
         found += [f"{path}:{node.lineno} {node.value!r}" for node in ast.walk(tree)
-                  if isinstance(node, ast.Constant) and node.value in words and id(node) not in docstrings]
+                  if isinstance(node, ast.Constant) and id(node) not in docstrings
+                  and (node.value in kinds or (node.value in targets and id(node) in compared))]
     return found
 
 
@@ -122,6 +127,6 @@ def test_only_the_core_names_the_target_kinds(tmp_path):
     above += [*(ROOT / "operators").rglob("*.py"), *(ROOT / "hao_addon").glob("*.py")]
     assert kind_literals(above) == []
     check = tmp_path / "check.py"
-    check.write_text('def f(settings):\n    """color-attribute"""\n    return settings.target == "color-attribute"\n',
+    check.write_text('def f(settings):\n    """color-attribute"""\n    return settings.target == "image"\n',
                      encoding="utf-8")
-    assert kind_literals([check]) == [f"{check}:3 'color-attribute'"]
+    assert kind_literals([check]) == [f"{check}:3 'image'"]

@@ -50,3 +50,7 @@ def kind_name(target_setting: str, high_to_low: bool) -> str:
 def target_kind(target_setting: str, high_to_low: bool = False) -> TargetKind:
     """The row of kind_name."""
     return TARGET_KINDS[kind_name(target_setting, high_to_low)]
+
+
+# The Target setting's value that bakes images of the mesh's own surface (a thickness map's inner bake).
+IMAGE_TARGET = TARGET_KINDS["texels"].target
