@@ -56,7 +56,7 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
         self.layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
         col = _split_layout(self.layout)
         col.prop(settings, "target")
-        for name in target_kind(settings.target).settings:  # the Target's own settings (its row's)
+        for name in target_kind(settings.to_settings().target).settings:  # the Target's own settings (its row's)
             col.prop(settings, name)
         _props(col, settings, "size", "occluders", "method")
 
@@ -67,7 +67,7 @@ class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
     bl_label = "Output"
 
     def draw_settings(self, col, settings, context):
-        col.active = settings.target == "image"  # the image outputs
+        col.active = target_kind(settings.to_settings().target).writes_images  # the image outputs
         col.prop(settings, "uv_mode")
         if settings.uv_mode == 'NAMED':
             obj = context.active_object
@@ -78,7 +78,7 @@ class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
         _props(col, settings, "margin", "texture_set")
         col.template_ID(settings, "image", new="image.new", open="image.open")
         _props(col, settings, "filepath", "png_bits")
-        _active_column(col, settings.png_bits == "8").prop(settings, "dither")
+        _active_column(col, settings.to_options().png_bits == "8").prop(settings, "dither")
         _props(col, settings, "frame_range", "wire_material")
 
 
@@ -109,7 +109,7 @@ class VIEW3D_PT_hao_bake_maps(_BakeSubPanel, bpy.types.Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw_settings(self, col, settings, context):
-        col.active = settings.target == "image"
+        col.active = target_kind(settings.to_settings().target).writes_images
         for kind in EXTRA_MAPS:
             block = col.column()
             if kind.setting:
@@ -126,14 +126,15 @@ class VIEW3D_PT_hao_bake_quality(_BakeSubPanel, bpy.types.Panel):
     bl_label = "Quality"
 
     def draw_settings(self, col, settings, context):
+        values = settings.to_settings()  # the core's words, not the enums' identifiers
         col.prop(settings, "quality")
-        if settings.quality in QUALITY_CAPS:  # a preset caps itself
-            col.label(text=f"Up to {QUALITY_CAPS[settings.quality]} directions")
+        if values.quality in QUALITY_CAPS:  # a preset caps itself
+            col.label(text=f"Up to {QUALITY_CAPS[values.quality]} directions")
         else:
-            col.prop(settings, "directions", **({} if settings.quality == "fixed" else {"text": "Max Directions"}))
-        _active_column(col, settings.quality in ("custom", "fixed")).prop(settings, "max_error")
+            col.prop(settings, "directions", **({} if values.quality == "fixed" else {"text": "Max Directions"}))
+        _active_column(col, values.quality in ("custom", "fixed")).prop(settings, "max_error")
         _props(col, settings, "view_samples", "samples_per_texel", "seed")
-        checked = _active_column(col, settings.target == "image")  # texels of a UV layout
+        checked = _active_column(col, target_kind(values.target).writes_images)  # texels of a UV layout
         checked.prop(settings, "verify")
         _active_column(checked, settings.verify > 0).prop(settings, "verify_max_error")
 
@@ -145,15 +146,16 @@ class VIEW3D_PT_hao_bake_advanced(_BakeSubPanel, bpy.types.Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw_settings(self, col, settings, context):
+        values = settings.to_settings()  # the core's words, not the enums' identifiers
         col.prop(settings, "max_distance")
-        _active_column(col, settings.max_distance > 0.0).prop(settings, "falloff")
+        _active_column(col, values.max_distance > 0.0).prop(settings, "falloff")
         _props(col, settings, "weighting", "spread_angle", "min_distance", "normals")
-        sub = _active_column(col, settings.normals == 'mesh')
+        sub = _active_column(col, values.normals == 'mesh')
         sub.prop(settings, "terminator")
-        _active_column(sub, settings.normals == 'mesh' and settings.terminator == 'setting').prop(
+        _active_column(sub, values.normals == 'mesh' and values.terminator == 'setting').prop(
             settings, "terminator_offset")
         _props(col, settings, "ignore_back_faces", "alpha")
-        _active_column(col, settings.alpha == "clip").prop(settings, "alpha_clip")
+        _active_column(col, values.alpha == "clip").prop(settings, "alpha_clip")
 
 
 BAKE_PANELS = (VIEW3D_PT_hao_bake, VIEW3D_PT_hao_bake_output, VIEW3D_PT_hao_bake_selected, VIEW3D_PT_hao_bake_maps,
@@ -177,6 +179,7 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         props = context.scene.hao_view
+        values = props.to_settings()  # the core's words, not the enums' identifiers
         col = layout.column()
         col.prop(props, "rays")
         col.prop(props, "march")
@@ -189,7 +192,7 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         sub.prop(props, "falloff")
         col.prop(props, "grid")
         sub = col.column()
-        sub.active = props.march == "hierarchical"
+        sub.active = values.march == "hierarchical"
         sub.prop(props, "cascades")
         col.prop(props, "scale")
         col.prop(props, "filter_size")
@@ -204,7 +207,7 @@ class VIEW3D_PT_hao_view(bpy.types.Panel):
         col.separator()
         col.prop(props, "method")
         sub = col.column()
-        sub.active = props.method == "near+far"
+        sub.active = values.method == "near+far"
         sub.prop(props, "near_radius")
         col.prop(props, "epsilon")
         col.prop(props, "show_spheres")

@@ -12,10 +12,11 @@ from ..hao_addon.blender.bake_request import BakeRequest
 from ..hao_addon.core.bake.settings import BakeSettings
 from ..hao_addon.core.bake.job_options import JobOptions
 from ..hao_addon.core.bake.map_kinds import EXTRA_MAPS
-from .setting_props import setting_annotations, settings_from
+from ..hao_addon.core.bake.target_kinds import target_kind
+from .setting_props import EnumAliases, enum_aliases, setting_annotations, settings_from
 
 
-class HAO_PG_bake_settings(bpy.types.PropertyGroup):
+class HAO_PG_bake_settings(EnumAliases, bpy.types.PropertyGroup):
     # What the bake computes comes from BakeSettings, which meshes occlude and how outputs are
     # laid out from JobOptions (setting_annotations, below); these say which objects, UV map
     # and outputs the Blender job uses.
@@ -54,6 +55,9 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
     def to_settings(self) -> BakeSettings:
         return settings_from(self, BakeSettings)
 
+    def to_options(self) -> JobOptions:
+        return settings_from(self, JobOptions)
+
     def to_request(self, targets: list, active=None) -> BakeRequest:
         """targets: the selected meshes; with Match Names they form bake groups by name, each
         low-poly baked from its group's highs; with Selected to Active the active one is
@@ -70,7 +74,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
                 high_poly = [cage]
             targets = [active] if active is not None else []
         settings = self.to_settings()
-        to_image = settings.target == "image"  # a colour attribute ignores the image outputs
+        to_image = target_kind(settings.target).writes_images  # a colour attribute ignores the image outputs
         options = settings_from(self, JobOptions)
         options = replace(options, texture_set=options.texture_set and to_image and not self.selected_to_active)
         return BakeRequest(targets=targets, settings=settings, options=options, uv_map=uv, groups=groups, notes=notes,
@@ -83,7 +87,7 @@ class HAO_PG_bake_settings(bpy.types.PropertyGroup):
     def map_paths(self, settings: BakeSettings) -> dict[str, str]:
         """The Save ... To files of the maps besides the AO (core/bake/map_kinds.py) that this
         bake writes: image bakes only, each with its setting on where it needs one."""
-        if settings.target != "image":
+        if not target_kind(settings.target).writes_images:
             return {}
         return {kind.key: path for kind in EXTRA_MAPS if (path := getattr(self, kind.property_name))
                 and (not kind.setting or getattr(settings, kind.setting))}
@@ -105,6 +109,7 @@ def map_file_annotations() -> dict:
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(BakeSettings))
 HAO_PG_bake_settings.__annotations__.update(setting_annotations(JobOptions))
 HAO_PG_bake_settings.__annotations__.update(map_file_annotations())
+HAO_PG_bake_settings._enum_aliases = {**enum_aliases(BakeSettings), **enum_aliases(JobOptions)}
 
 
 def register() -> None:

@@ -30,14 +30,37 @@ def tooltip(text: str) -> str:
 
 
 def enum_items(choices) -> tuple:
-    """EnumProperty items of core Choice definitions."""
-    return tuple((str(c.value), c.label, tooltip(c.description)) for c in choices)
+    """EnumProperty items of core Choice definitions (their order is the number a .blend file
+    stores, unchanged since the first release)."""
+    return tuple((c.identifier, c.label, tooltip(c.description)) for c in choices)
+
+
+def enum_aliases(settings_cls) -> dict[str, dict[str, str]]:
+    """{property: {earlier identifier: identifier}} of every enum setting: the core's words
+    ('visible', 'color-attribute'), which the previous releases' panel used, still set it."""
+    return {f.name: {str(c.value): c.identifier for c in spec.choices if str(c.value) != c.identifier}
+            for f, spec in specs(settings_cls) if spec.ui and spec.choices}
+
+
+class EnumAliases:
+    """A property group mixin: its enum properties also take their earlier identifiers
+    (_enum_aliases: {property: {earlier: identifier}}, enum_aliases), so scripts, presets
+    and farm submitters written against an earlier release keep working."""
+
+    _enum_aliases: dict = {}
+
+    def __setattr__(self, name: str, value) -> None:
+        aliases = type(self)._enum_aliases.get(name)
+        if aliases and isinstance(value, str):
+            value = aliases.get(value, value)
+        super().__setattr__(name, value)
 
 
 def blender_property(field, spec, update=None):
     """The bpy.props definition of one setting."""
     kw = {"name": spec.label, "description": spec.sentence,
-          "default": str(field.default) if spec.choices else field.default}
+          "default": next(c.identifier for c in spec.choices if c.value == field.default) if spec.choices
+          else field.default}
     if update is not None:
         kw["update"] = update
     if spec.choices:
@@ -75,7 +98,7 @@ def settings_from(group: bpy.types.PropertyGroup, settings_cls):
 
 
 def from_property(field, spec, value):
-    """A property's value as the setting holds it: an enum identifier back to its number."""
-    if spec.choices and isinstance(field.default, int):
-        return int(value)
+    """A property's value as the setting holds it: an enum identifier back to its Choice's value."""
+    if spec.choices:
+        return next(c.value for c in spec.choices if c.identifier == value)
     return value

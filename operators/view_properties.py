@@ -5,7 +5,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, PointerProperty
 
 from ..hao_addon.core.hao.view_settings import ViewAOSettings
-from .setting_props import setting_annotations, settings_from
+from .setting_props import EnumAliases, enum_aliases, setting_annotations, settings_from
 
 
 def _redraw(self, context):
@@ -15,7 +15,7 @@ def _redraw(self, context):
                 area.tag_redraw()
 
 
-class HAO_PG_view_settings(bpy.types.PropertyGroup):
+class HAO_PG_view_settings(EnumAliases, bpy.types.PropertyGroup):
     enabled: BoolProperty(
         name="HAO", description="Show Hybrid Ambient Occlusion in the 3D viewport: voxel-traced, so objects "
                                 "off screen or hidden behind others still darken what they should",
@@ -49,6 +49,7 @@ class HAO_PG_view_settings(bpy.types.PropertyGroup):
 
 # Rays, steps, distance, grid, ... from the core's ViewAOSettings (one definition each).
 HAO_PG_view_settings.__annotations__.update(setting_annotations(ViewAOSettings, update=_redraw))
+HAO_PG_view_settings._enum_aliases = enum_aliases(ViewAOSettings)
 
 
 def register() -> None:

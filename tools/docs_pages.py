@@ -65,7 +65,7 @@ def table(*settings_classes) -> str:
                 default += f" (command line: `{spec.cli_default}`)"
             what = spec.sentence
             if spec.choices:
-                what += ": " + "; ".join(f"*{c.label}* (`{c.value}`) {c.description}" for c in spec.choices)
+                what += ": " + "; ".join(f"*{c.label}* (`{c.value}`, Python `'{c.identifier}'`) {c.description}" for c in spec.choices)
             rows.append(f"| {label} | {option} | {default} | {spec.range_text() or '-'} | {what}. |")
     return "\n".join(rows)
 

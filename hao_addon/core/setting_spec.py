@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any, Iterator
 
@@ -17,11 +18,17 @@ from .errors import UserInputError
 @dataclass(frozen=True)
 class Choice:
     """One allowed value: a word (a mode) or a number (a count). Reports and the command
-    line use the value as it is; a Blender enum, whose identifiers are strings, its str()."""
+    line use the value as it is; a Blender enum its UPPER_CASE str() (operators/setting_props.py)."""
 
     value: str | int
     label: str
     description: str
+
+    @property
+    def identifier(self) -> str:
+        """Its identifier in a Blender enum: UPPER_CASE, as in all of Blender's Python API
+        ('color-attribute' -> 'COLOR_ATTRIBUTE', 'near+far' -> 'NEAR_FAR'; '16' stays)."""
+        return re.sub(r"[^A-Z0-9]+", "_", str(self.value).upper())
 
 
 @dataclass(frozen=True)
