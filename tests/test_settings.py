@@ -53,8 +53,8 @@ def test_panel_properties_match_the_core(addon, cls, command, group):
         prop = rna[f.name]
         assert prop.name == spec.label and prop.description.lower().startswith(spec.description[:20].lower())
         if spec.choices:
-            assert [i.identifier for i in prop.enum_items] == [str(c.value) for c in spec.choices]
-            assert prop.default == str(f.default)
+            assert [i.identifier for i in prop.enum_items] == [c.identifier for c in spec.choices]
+            assert prop.default == next(c.identifier for c in spec.choices if c.value == f.default)
             continue
         if isinstance(f.default, bool):
             assert prop.default == f.default

@@ -61,8 +61,6 @@ def table(*settings_classes) -> str:
             option = f"`{spec.option(f.name) or spec.cli_via}`" if spec.option(f.name) or spec.cli_via else "(panel only)"
             label = spec.label if spec.ui else "(command line only)"
             default = f"`{f.default}`" if not isinstance(f.default, bool) else ("on" if f.default else "off")
-            if spec.cli_default is not None:
-                default += f" (command line: `{spec.cli_default}`)"
             what = spec.sentence
             if spec.choices:
                 what += ": " + "; ".join(f"*{c.label}* (`{c.value}`, Python `'{c.identifier}'`) {c.description}" for c in spec.choices)

@@ -8,16 +8,11 @@ import argparse
 from ..core.setting_spec import Spec, specs
 
 
-def cli_default(field, spec: Spec):
-    """The option's default: the field's, unless the spec gives the command line its own."""
-    return field.default if spec.cli_default is None else spec.cli_default
-
-
 def option_help(field, spec: Spec) -> str:
     parts = [spec.description]
     if spec.choices:
         parts.append("; ".join(f"{c.value}: {c.description}" for c in spec.choices)
-                     + f" (default {cli_default(field, spec)})")
+                     + f" (default {field.default})")
     elif not isinstance(field.default, bool):
         parts.append(f"{spec.range_text()}; default {field.default}")
     return (". ".join(parts)).replace("%", "%%")
@@ -34,7 +29,7 @@ def add_setting_options(parser: argparse.ArgumentParser, settings_cls) -> None:
             parser.add_argument(option, dest=f.name, action="store_true", default=f.default, help=help_text)
         elif spec.choices:
             parser.add_argument(option, dest=f.name, choices=[c.value for c in spec.choices],
-                                type=type(f.default), default=cli_default(f, spec), help=help_text)
+                                type=type(f.default), default=f.default, help=help_text)
         else:
             parser.add_argument(option, dest=f.name, type=type(f.default), default=f.default,
                                 metavar=f.name.upper(), help=help_text)

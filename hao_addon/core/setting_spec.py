@@ -52,7 +52,6 @@ class Spec:
     subtype: str = ""
     cli: str | None = ""
     cli_via: str = ""
-    cli_default: Any = None
     ui: bool = True
 
     @property

@@ -34,9 +34,9 @@ class JobOptions:
     """Which meshes occlude and how the outputs are laid out (see each field's description)."""
 
     occluders: str = setting(
-        "selected", label="Occluders", choices=OCCLUDER_CHOICES, cli_default="visible",
-        description="what casts occlusion onto the baked mesh (the command line's default is visible: what "
-                    "a loaded file happens to have selected is no choice made for the bake)")
+        "visible", label="Occluders", choices=OCCLUDER_CHOICES,
+        description="what casts occlusion onto the baked mesh (by default every visible mesh, as Cycles' bake: "
+                    "the panel and the command line alike)")
     texture_set: bool = setting(
         False, label="Texture Set",
         description="bake the meshes together into one shared image 'TextureSet_AO', each on its own UVs "
