@@ -80,3 +80,14 @@ def test_the_viewport_takes_its_earlier_identifiers(scene):
     assert view.march == 'HIERARCHICAL'
     with pytest.raises(TypeError, match="not found"):
         view.march = 'sideways'  # an unknown word is still refused, by Blender's own message
+
+
+def test_the_panel_and_the_command_line_share_the_occluders_default(scene):
+    """Issue 41 item 3: every visible mesh occludes by default, as in Cycles' bake, whether the
+    bake starts from the panel or from the command line (one definition, no second default)."""
+    from hao_addon.cli.parser import build_parser
+    from hao_addon.core.bake.job_options import JobOptions
+    assert JobOptions().occluders == "visible"
+    assert scene.hao_bake.occluders == 'VISIBLE' and scene.hao_bake.to_options().occluders == "visible"
+    args = build_parser().parse_args(["bake", "in.obj", "--out", "ao.png"])
+    assert args.occluders == "visible"
