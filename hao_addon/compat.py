@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The one place where supported Blender releases (4.2 LTS to 5.2 LTS) differ for this add-on.
+"""The one place where supported Blender releases (4.2 LTS to 5.3) differ for this add-on.
 
 Every other module calls these instead of testing versions itself. Imports of ``bpy`` and
 ``gpu`` are local, so the core floor can import this module's constants without Blender.

@@ -216,7 +216,7 @@ def test_gather_batch_size_follows_the_depth_map_budget():
     def per_dispatch(side, directions=256, max_distance=0.0):
         settings = SimpleNamespace(max_distance=max_distance, directions=directions)
         return bake_gather.views_per_dispatch(SimpleNamespace(max_view_side=side, settings=settings,
-                                                              layered=max_distance > 0.0))
+                                                              layered=max_distance > 0.0, direction_count=directions))
     assert [per_dispatch(s) for s in (256, 1024, 1448, 2048, 4096)] == [16, 16, 8, 4, 1]
     assert [per_dispatch(256, d) for d in (1, 8, 16, 20, 64, 96, 100)] == [1, 8, 16, 10, 16, 16, 15]
     assert per_dispatch(256, max_distance=1.0) == 1

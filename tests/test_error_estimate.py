@@ -269,7 +269,7 @@ def test_rounds_can_leave_converged_texels_out(gpu_context, monkeypatch, method)
     """With SKIP_CONVERGED on (the benchmark's comparison), a round after the pilot bakes only
     the texels not yet converged: fewer receivers traced or listed (counted)."""
     import hao_addon.bake as bake_module
-    import hao_addon.core.bake.target_layouts as plan_module  # the projected kind casts its rays there
+    import hao_addon.core.bake.plan as plan_module
     monkeypatch.setattr(bake_module, "SKIP_CONVERGED", True)
     listed = []
     original = plan_module.BakePlan.receivers

@@ -1,8 +1,8 @@
 # Blender releases the project is tested on (sourced by setup.sh and test.sh).
 # Each has requirements/bpy-<version>.txt whose first line names its Python ("... on Python 3.11").
 
-HAO_DEFAULT_BPY=5.2.3          # development and the sample job: .venv
-HAO_CI_BPY="4.2.23 5.2.3"      # the oldest and the newest supported release: what CI tests
+HAO_DEFAULT_BPY=5.3.0          # development and the sample job: .venv
+HAO_CI_BPY="4.2.23 5.3.0"      # the oldest and the newest supported release: what CI tests
 
 requirements_for() {
   local req="requirements/bpy-$1.txt"
