@@ -52,8 +52,13 @@ class TexelLayout:
     @classmethod
     def made(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None, centre: np.ndarray,
              scale: float, cast: RayCast | None, earlier: tuple | None) -> Generator[float, None, "TexelLayout"]:
-        """The layout of `target` (the kind's steps; this kind's take none)."""
+        """The layout of `target` (the kind's steps: a projection yields its progress; the
+        others take none)."""
         yield from ()
+        return cls.of(target, settings, udim)
+
+    @classmethod
+    def of(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None) -> "TexelLayout":
         return cls(settings.size, settings.sample_count, udim)
 
     @property
@@ -206,9 +211,7 @@ class CornerLayout(TexelLayout):
     per_element: ClassVar[bool] = True
 
     @classmethod
-    def made(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None, centre: np.ndarray,
-             scale: float, cast: RayCast | None, earlier: tuple | None) -> Generator[float, None, "CornerLayout"]:
-        yield from ()
+    def of(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None) -> "CornerLayout":
         return cls(settings.size, 1, None, target.corners)
 
     @property
