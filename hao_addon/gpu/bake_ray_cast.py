@@ -86,12 +86,10 @@ class GpuRayCast(util.GPUPass):
         """Cast rays first..end (their rows of the list; invocations past end return)."""
         shader = ray_cast_shader()
         shader.bind()
-        shader.uniform_int("first_ray", first)
-        shader.uniform_int("ray_end", end)
-        shader.uniform_int("dims", tuple(int(d) for d in self.grid.dims))
-        shader.uniform_float("reach", reach)
-        for name in ("tri_corners", "cell_start", "cell_triangles", "ray_origin", "ray_direction"):
-            shader.uniform_sampler(name, getattr(self, name))
+        names = ("tri_corners", "cell_start", "cell_triangles", "ray_origin", "ray_direction")
+        util.set_inputs(shader, samplers={name: getattr(self, name) for name in names},
+                        ints={"first_ray": first, "ray_end": end, "dims": tuple(int(d) for d in self.grid.dims)},
+                        floats={"reach": reach})
         shader.image("hit_out", self.hit)
         rows = -(-(end - first) // LIST_WIDTH)
         gpu.compute.dispatch(shader, LIST_WIDTH // GROUP_SIZE, rows, 1)
