@@ -63,3 +63,16 @@ def material_node_tree(material):
     if bpy.app.version >= (5, 0, 0) or material.use_nodes:
         return material.node_tree
     return None
+
+
+def set_shader_inputs(shader, samplers: dict, ints: dict | None = None, floats: dict | None = None) -> None:
+    """Set a bound shader's samplers ({name: GPUTexture}), then its push constants ({name:
+    value}). In this order on every release: Blender 5.3's uniform_sampler overwrites the
+    first push constant set before it with the sampler's slot (every Selected-to-Active ray
+    then missed; tests/test_gpu_inputs.py)."""
+    for name, texture in samplers.items():
+        shader.uniform_sampler(name, texture)
+    for name, value in (ints or {}).items():
+        shader.uniform_int(name, value)
+    for name, value in (floats or {}).items():
+        shader.uniform_float(name, value)

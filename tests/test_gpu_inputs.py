@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""A shader's push constants keep their values when its samplers are set (gpu/util.set_inputs).
+"""A shader's push constants keep their values when its samplers are set (compat.set_shader_inputs).
 Blender 5.3's uniform_sampler overwrites the first push constant set before it with the
 sampler's slot: every Selected-to-Active ray of the GPU cast missed (its first push constant
 is the first ray), and the viewport's composite lost its region offset."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import gpu
 import numpy as np
 
-from hao_addon.gpu import util
+from hao_addon import compat
 
 
 def _probe_shader() -> "gpu.types.GPUShader":
@@ -29,8 +29,8 @@ def test_push_constants_survive_the_samplers(gpu_context):
     out = gpu.types.GPUTexture((1, 1), format='RGBA32F')
     textures = [gpu.types.GPUTexture((1, 1), format='RGBA32F') for _ in range(2)]
     shader.bind()
-    util.set_inputs(shader, samplers={"tex0": textures[0], "tex1": textures[1]}, ints={"first": 7},
-                    floats={"second": 3.5})
+    compat.set_shader_inputs(shader, samplers={"tex0": textures[0], "tex1": textures[1]}, ints={"first": 7},
+                             floats={"second": 3.5})
     shader.image("out_values", out)
     gpu.compute.dispatch(shader, 1, 1, 1)
     gpu.shader.unbind()

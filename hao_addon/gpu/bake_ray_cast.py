@@ -14,6 +14,7 @@ from typing import Generator
 import gpu
 import numpy as np
 
+from .. import compat
 from ..core.bake.projection import barycentric_from_uv
 from ..core.bake.ray_grid import UniformGrid, build_grid
 from ..core.errors import BakeInputError
@@ -87,9 +88,10 @@ class GpuRayCast(util.GPUPass):
         shader = ray_cast_shader()
         shader.bind()
         names = ("tri_corners", "cell_start", "cell_triangles", "ray_origin", "ray_direction")
-        util.set_inputs(shader, samplers={name: getattr(self, name) for name in names},
-                        ints={"first_ray": first, "ray_end": end, "dims": tuple(int(d) for d in self.grid.dims)},
-                        floats={"reach": reach})
+        compat.set_shader_inputs(shader, samplers={name: getattr(self, name) for name in names},
+                                 ints={"first_ray": first, "ray_end": end,
+                                       "dims": tuple(int(d) for d in self.grid.dims)},
+                                 floats={"reach": reach})
         shader.image("hit_out", self.hit)
         rows = -(-(end - first) // LIST_WIDTH)
         gpu.compute.dispatch(shader, LIST_WIDTH // GROUP_SIZE, rows, 1)

@@ -45,7 +45,7 @@ def draw_composite(ao_tex, depth_tex, strength: float, region_offset: tuple[int,
         gpu.state.depth_test_set('LESS_EQUAL')
         gpu.state.depth_mask_set(False)
         shader.bind()
-        util.set_inputs(shader, samplers={"ao_tex": ao_tex, "depth_tex": depth_tex},
-                        ints={"region_offset": region_offset}, floats={"strength": strength})
+        compat.set_shader_inputs(shader, samplers={"ao_tex": ao_tex, "depth_tex": depth_tex},
+                                  ints={"region_offset": region_offset}, floats={"strength": strength})
         _TRIANGLE.draw(shader)
 

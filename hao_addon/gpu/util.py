@@ -138,20 +138,6 @@ def texture_to_numpy(tex: "gpu.types.GPUTexture", dtype=np.float32) -> np.ndarra
 
 
 
-def set_inputs(shader: "gpu.types.GPUShader", samplers: dict, ints: dict | None = None,
-               floats: dict | None = None) -> None:
-    """Set a bound shader's samplers ({name: GPUTexture}), then its push constants ({name:
-    value}). In this order on every release: Blender 5.3's uniform_sampler overwrites the
-    first push constant set before it with the sampler's slot (every Selected-to-Active ray
-    then missed; tests/test_gpu_inputs.py)."""
-    for name, texture in samplers.items():
-        shader.uniform_sampler(name, texture)
-    for name, value in (ints or {}).items():
-        shader.uniform_int(name, value)
-    for name, value in (floats or {}).items():
-        shader.uniform_float(name, value)
-
-
 def image_barrier() -> None:
     """Make image writes of earlier draws visible to later reads. gpu.compute.dispatch()
     issues GPU_memory_barrier(TEXTURE_FETCH | SHADER_IMAGE_ACCESS) after it runs; draws issue
