@@ -284,7 +284,8 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     o_normals, _ = face_normals_areas(o_pos)
     inv_s = _inverse_normalizers(normals, areas, directions, settings)
     corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
-    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, layout.extent)
+    extent = layout.extent  # (over every projected point: once)
+    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, extent)
 
     drawn = np.concatenate(([t_pos.reshape(-1, 3)] if kind.target_occludes else []) + [o_pos.reshape(-1, 3)])
     target_weld = weld(t_pos.reshape(-1, 3))
@@ -301,7 +302,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         target_faces=np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), target_corners=corners,
         target_above=above, occluder_positions=o_pos.astype(np.float32),
         occluder_normals=np.asarray(o_normals, dtype=np.float32), directions=directions, pixel_size=pixel_size,
-        max_view_side=int(np.ceil(2.0 * layout.extent / pixel_size)) + 4,
+        max_view_side=int(np.ceil(2.0 * extent / pixel_size)) + 4,
         # Distinct corners: a light view's window is fitted to them (shared corners once).
         target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,

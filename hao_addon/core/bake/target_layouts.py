@@ -23,6 +23,7 @@ from .projection import RayCast, projected_receivers_steps
 from .receivers import Receivers, corner_receivers, uv_receivers
 from .seams import element_values, estimated, finalize_map, finalize_vectors
 from .settings import BakeSettings
+from .target_kinds import TARGET_KINDS
 from .targets import BakeTarget
 from .udim import UdimLayout
 from .vertex_target import VertexTarget
@@ -46,8 +47,6 @@ class TexelLayout:
     sample_count: int
     udim: UdimLayout | None = None
     KIND: ClassVar[str] = "texels"
-    # A value per vertex or corner, not a map: no margins, no texels to cover.
-    per_element: ClassVar[bool] = False
 
     @classmethod
     def made(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None, centre: np.ndarray,
@@ -60,6 +59,12 @@ class TexelLayout:
     @classmethod
     def of(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None) -> "TexelLayout":
         return cls(settings.size, settings.sample_count, udim)
+
+    @property
+    def per_element(self) -> bool:
+        """A value per vertex or corner, not a map (its kind's row writes no images): no
+        margins, no texels to cover."""
+        return not TARGET_KINDS[self.KIND].writes_images
 
     @property
     def output_shape(self) -> tuple[int, ...]:
@@ -208,7 +213,6 @@ class CornerLayout(TexelLayout):
 
     corners: VertexTarget | None = None
     KIND: ClassVar[str] = "corners"
-    per_element: ClassVar[bool] = True
 
     @classmethod
     def of(cls, target: BakeTarget, settings: BakeSettings, udim: UdimLayout | None) -> "CornerLayout":
@@ -239,5 +243,4 @@ class CornerLayout(TexelLayout):
         return (*element_values(*estimator.ratio(sums)), None)
 
 
-TargetLayout = TexelLayout  # the base every kind's layout extends
 LAYOUTS: dict[str, type[TexelLayout]] = {layout.KIND: layout for layout in (TexelLayout, ProjectedLayout, CornerLayout)}
