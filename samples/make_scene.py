@@ -23,6 +23,8 @@ def main(out: str) -> None:
     bpy.ops.object.camera_add(location=(3.9, -4.3, 2.6), rotation=(math.radians(70), 0.0, math.radians(42)))
     bpy.context.scene.camera = bpy.context.active_object
     bpy.context.active_object.name = "Camera"
+    bpy.context.view_layer.objects.active = spot  # what a bake of this file without --object bakes
+    Path(out).resolve().parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=str(Path(out).resolve()))
 
 

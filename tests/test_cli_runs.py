@@ -107,6 +107,36 @@ def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
     assert corners(ROOT / "tests" / "data" / "CesiumMan.glb") > 0
 
 
+def test_several_meshes_bake_the_active_one_and_say_it_or_are_refused(dirs, tmp_path):
+    """A file with several meshes and no --object: a .blend bakes its active mesh, as Blender's
+    own bake does, and a line (and the report) says which and what occludes it; an input
+    without an active mesh (an .obj of two objects) is refused with their names and how to
+    choose, writing nothing; never one mesh silently."""
+    out, tmp = dirs
+    blend = tmp_path / "two.blend"
+    script = ("import bpy; bpy.ops.wm.read_factory_settings(use_empty=True);"
+              "bpy.ops.mesh.primitive_plane_add(size=8); bpy.ops.mesh.primitive_cube_add(location=(0, 0, 1));"
+              "bpy.ops.object.camera_add(location=(0, -6, 2)); cube = bpy.data.objects['Cube'];"
+              "bpy.context.view_layer.objects.active = cube;"
+              f"bpy.ops.wm.save_as_mainfile(filepath=r'{blend}');"
+              f"bpy.ops.wm.obj_export(filepath=r'{tmp_path / 'two.obj'}', export_materials=False)")
+    assert subprocess.run([sys.executable, "-c", script], capture_output=True).returncode == 0
+    report = out / "r.json"
+    proc = run(["bake", blend, "--size", "32", "--directions", "4", "--out", out / "a.png", "--json", report], tmp)
+    assert proc.returncode == 0, proc.stderr
+    said = "hao: baking 'Cube', the file's active object ('Plane' occlude it; --object NAME or --all-meshes"
+    assert proc.stdout.startswith(said) and "hao: baked 'Cube'" in proc.stdout, proc.stdout
+    assert json.loads(report.read_text())["notes"][0].startswith(said)
+    proc = run(["bake", tmp_path / "two.obj", "--size", "32", "--directions", "4", "--out", out / "b.png"], tmp)
+    assert proc.returncode == 2 and proc.stderr == (
+        "hao: error: the input has 2 meshes ('Cube', 'Plane') and no active mesh object: choose with --object NAME "
+        "(repeatable), or bake each with --all-meshes\n"), proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["a.png", "r.json"] and list(tmp.iterdir()) == []
+    proc = run(["bake", tmp_path / "two.obj", "--all-meshes", "--size", "32", "--directions", "4", "--out",
+                out / "{object}.png", "--quiet"], tmp)
+    assert proc.returncode == 0 and {"Cube.png", "Plane.png"} <= {p.name for p in out.iterdir()}, proc.stderr
+
+
 def test_output_checks_come_before_any_work(dirs):
     """A legal 254-byte name bakes (the temporary name is short); a folder that cannot be
     made fails before the scene is loaded or the GPU is touched."""

@@ -68,14 +68,14 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
         from .skip import skip_finished
         left, skip_lines = skip_finished(request, run.key, report)
         if left is None:
-            return skip_lines
+            return report.notes + skip_lines
         if left is not request:  # the frames still missing
             request = left
             job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
     start_gpu()
     t0 = time.perf_counter()
     _bake_and_write(job, run, targets, report, progress)
-    return skip_lines + _report_results(job, run, args, report, time.perf_counter() - t0)
+    return report.notes + skip_lines + _report_results(job, run, args, report, time.perf_counter() - t0)
 
 
 def _checked_run(args, report: Report) -> _Run:
@@ -180,11 +180,14 @@ def _pick_objects(args, report: Report) -> tuple[list, list | None, object]:
         raise CLIError("--cage needs --high-poly (Selected to Active)")
     exclude = tuple(high_poly or ()) + ((cage,) if cage else ())
     if args.all_meshes:
-        targets = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
+        targets = [o for o in bpy.context.view_layer.objects
+                   if o.type == 'MESH' and o not in exclude and o.visible_get()]
         if not targets:
             raise CLIError("the input contains no mesh object")
     else:
-        targets = [pick_target(name, exclude) for name in (args.object or [""])]
+        picked = [pick_target(name, exclude, args.input.lower().endswith(".blend")) for name in (args.object or [""])]
+        targets = [obj for obj, _why in picked]
+        report.notes.extend(why for _obj, why in picked if why)
     if len({o.name for o in targets}) != len(targets):
         raise CLIError("--object names the same mesh twice")
     if args.texture_set and len(targets) < 2:

@@ -230,6 +230,8 @@ class Report:
     timings: dict = field(default_factory=dict)
     outputs: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    # Choices the run made for the user that it says (which of several meshes it baked).
+    notes: list = field(default_factory=list)
     # A batch: one report per input (as_dict), and the failed ones' lines.
     inputs: list = field(default_factory=list)
     input_errors: list = field(default_factory=list)
@@ -272,6 +274,8 @@ class Report:
             del out["skipped"]
         if self.shaders_compiled is None:
             del out["shaders_compiled"]
+        if not self.notes:
+            del out["notes"]
         return out
 
     def to_json(self) -> str:

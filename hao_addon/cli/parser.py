@@ -95,16 +95,17 @@ def add_bake_arguments(b: argparse.ArgumentParser) -> None:
                         "files and settings (a key in its metadata) is kept, as is each such frame of --frames; "
                         "other files are baked again (a re-queued farm task redoes only what is missing)")
     b.add_argument("--all-meshes", action="store_true",
-                   help="bake every mesh of each input (each into its own file), not only the largest")
+                   help="bake every visible mesh of each input (each into its own file); without it and without --object, "
+                        "an input with several meshes bakes a .blend's active object (and says so) or is refused")
     add_setting_options(b, BakeSettings)
     b.add_argument("--uv-map", default="auto", help="UV map name, or 'auto' (first UV map, else an automatic unwrap)")
     b.add_argument("--object", action="append", default=None, metavar="NAME",
-                   help="mesh to bake (default: the mesh with the most faces); repeatable: each into its own "
+                   help="mesh to bake (default: the input's only mesh, else a .blend's active object); repeatable: each into its own "
                         "file ({object} in --out, else _NAME is added), or with --texture-set all into one")
     b.add_argument("--high-poly", action="append", default=None, metavar="PATH_OR_NAME",
                    help="Selected to Active: bake this high-poly onto the low-poly's UVs (repeatable): a "
                         ".obj/.glb/.gltf/.blend file whose meshes are the sources, or the name of a mesh in INPUT; "
-                        "the low-poly (--object, default the largest other mesh) does not occlude")
+                        "the low-poly (--object, default the only other mesh or the active one) does not occlude")
     b.add_argument("--cage", default="", metavar="NAME",
                    help="Selected to Active: a mesh in INPUT with the low-poly's topology that the rays start from "
                         "(instead of --cage-extrusion)")

@@ -186,16 +186,32 @@ def export_glb(objects: list, path: Path) -> None:
     export_mesh_file(objects, path)
 
 
-def pick_target(name: str, exclude: tuple = ()):
-    """The mesh to bake: by name, else the one with the most faces (not among exclude)."""
+def pick_target(name: str, exclude: tuple = (), from_blend: bool = False) -> tuple[object, str]:
+    """(the mesh to bake, a line saying why it was chosen or ""): by name; else the input's
+    only visible mesh (not among exclude: a hidden one, such as the bone shape a glTF import
+    keeps, is no candidate); else, in a .blend (from_blend), its active object, as
+    Blender's own bake does. Several meshes and none of these is a refusal that lists them:
+    never one of them silently."""
     import bpy
 
     if name:
         obj = bpy.data.objects.get(name)
         if obj is None or obj.type != 'MESH':
             raise CLIError(f"no mesh object named '{name}' (meshes: {_mesh_names()})")
-        return obj
-    meshes = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o not in exclude]
+        return obj, ""
+    meshes = [o for o in bpy.context.view_layer.objects
+              if o.type == 'MESH' and o not in exclude and o.visible_get()]
+    if not meshes and _mesh_names() != "none":
+        raise CLIError(f"the input's meshes are all hidden ({_mesh_names()}): name one with --object NAME")
     if not meshes:
         raise CLIError("the input contains no mesh object")
-    return max(meshes, key=lambda o: len(o.data.polygons))
+    if len(meshes) == 1:
+        return meshes[0], ""
+    names = ", ".join(f"'{o.name}'" for o in meshes)
+    active = bpy.context.view_layer.objects.active
+    if from_blend and active in meshes:
+        others = ", ".join(f"'{o.name}'" for o in meshes if o != active)
+        return active, (f"hao: baking '{active.name}', the file's active object ({others} occlude it; "
+                        "--object NAME or --all-meshes to bake others)")
+    raise CLIError(f"the input has {len(meshes)} meshes ({names}) and no active mesh object: choose with "
+                   "--object NAME (repeatable), or bake each with --all-meshes")
