@@ -80,6 +80,7 @@ class VIEW3D_PT_hao_bake_output(_BakeSubPanel, bpy.types.Panel):
         _props(col, settings, "filepath", "png_bits")
         _active_column(col, settings.to_options().png_bits == "8").prop(settings, "dither")
         _props(col, settings, "frame_range", "wire_material")
+        _active_column(col, settings.wire_material).prop(settings, "multiply_base_color")
 
 
 class VIEW3D_PT_hao_bake_selected(_BakeSubPanel, bpy.types.Panel):

@@ -49,7 +49,14 @@ class HAO_PG_bake_settings(EnumAliases, bpy.types.PropertyGroup):
                     "{frame} in Save To becomes the frame number; frames with unchanged meshes reuse their bake",
         default=False)
     wire_material: BoolProperty(
-        name="Add to Material", description="Add the AO image to the object's material and multiply it into Base Color",
+        name="Add to Material",
+        description="Add the AO image to the object's material as Blender's glTF exporter reads it: into the glTF "
+                    "Material Output's Occlusion socket (exports carry it; renders do not darken twice)",
+        default=False)
+    multiply_base_color: BoolProperty(
+        name="Multiply into Base Color",
+        description="Also multiply the AO into the Principled BSDF's Base Color (renders then darken by it on top "
+                    "of their own AO); off takes out a multiply an earlier bake added",
         default=False)
 
     def to_settings(self) -> BakeSettings:
@@ -80,6 +87,7 @@ class HAO_PG_bake_settings(EnumAliases, bpy.types.PropertyGroup):
         return BakeRequest(targets=targets, settings=settings, options=options, uv_map=uv, groups=groups, notes=notes,
                            image=self.image if to_image else None, filepath=self.filepath if to_image else "",
                            wire_material=self.wire_material and to_image,
+                           multiply_base_color=self.multiply_base_color,
                            high_poly=high_poly, cage=cage,
                            map_paths=self.map_paths(settings),
                            frames=self.scene_frames() if self.frame_range else None)

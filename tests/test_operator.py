@@ -180,11 +180,48 @@ def test_existing_image_is_overwritten_and_material_wired(scene):
     uvnode = tex[0].inputs["Vector"].links[0].from_node
     assert uvnode.uv_map == "UVMap"
     bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled')
-    assert bsdf.inputs["Base Color"].links[0].from_node.label == "HAO AO Multiply"
+    assert not bsdf.inputs["Base Color"].links  # the glTF Occlusion socket only: renders do not darken twice
     # Baking again does not stack more nodes.
     n_nodes = len(mat.node_tree.nodes)
     bpy.ops.object.hao_bake_ao()
     assert len(mat.node_tree.nodes) == n_nodes
+
+
+def test_add_to_material_feeds_gltf_occlusion_and_multiplies_only_when_asked(scene):
+    """Add to Material wires the AO as Blender's glTF exporter reads it (the glTF Material
+    Output's Occlusion), not into Base Color; every node it adds is named 'HAO AO ...' and sits
+    in the frame 'HAO AO'. Multiply into Base Color is the explicit choice, and a bake without
+    it takes an earlier multiply out, restoring what fed Base Color."""
+    obj = monkey()
+    mat = bpy.data.materials.new("Painted")
+    obj.data.materials.append(mat)
+    if mat.node_tree is None:  # before 5.0 a new material has no node tree
+        mat.use_nodes = True
+    tree = mat.node_tree
+    bsdf = next(n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled')
+    paint = tree.nodes.new('ShaderNodeRGB')
+    tree.links.new(paint.outputs[0], bsdf.inputs["Base Color"])
+    before = set(tree.nodes)
+    small_settings(scene, wire_material=True)
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    added = set(tree.nodes) - before
+    assert sorted(n.name for n in added) == ["HAO AO", "HAO AO Image", "HAO AO UV Map",
+                                             "HAO AO glTF Material Output"]
+    frame = tree.nodes["HAO AO"]
+    assert frame.bl_idname == 'NodeFrame' and all(n.parent == frame for n in added - {frame})
+    occlusion = tree.nodes["HAO AO glTF Material Output"].inputs["Occlusion"]
+    assert occlusion.links[0].from_node == tree.nodes["HAO AO Image"]
+    assert bsdf.inputs["Base Color"].links[0].from_node == paint
+    settings = scene.hao_bake
+    settings.multiply_base_color = True
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    mix = bsdf.inputs["Base Color"].links[0].from_node
+    assert mix.name == "HAO AO Multiply" and mix.parent == frame and mix.inputs[6].links[0].from_node == paint
+    assert mix.inputs[7].links[0].from_node == tree.nodes["HAO AO Image"]
+    settings.multiply_base_color = False
+    assert bpy.ops.object.hao_bake_ao() == {'FINISHED'}
+    assert "HAO AO Multiply" not in tree.nodes and bsdf.inputs["Base Color"].links[0].from_node == paint
+    assert set(tree.nodes) - before == added
 
 
 @pytest.mark.parametrize("ext", ["png", "exr"])

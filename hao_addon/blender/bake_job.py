@@ -440,7 +440,7 @@ class BakeJob:
             image = stored[self.label_of(obj)]
             obj[BAKED_AO_PROPERTY] = image.name  # viewport HAO can skip objects with a baked map
             if req.wire_material:
-                images.wire_into_material(obj, image, uv_name)
+                images.wire_into_material(obj, image, uv_name, req.multiply_base_color)
                 if (self.label_of(obj), "orm") in extra:  # glTF's ORM texture in place of the AO's
                     images.wire_orm(obj, extra[self.label_of(obj), "orm"], uv_name)
 

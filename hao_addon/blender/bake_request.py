@@ -72,6 +72,7 @@ class BakeRequest:
     image_name: str = ""
     filepath: str = ""
     wire_material: bool = False
+    multiply_base_color: bool = False  # with wire_material: the AO also multiplies Base Color
     source_path: str = ""  # the file the scene was loaded from (CLI): never overwritten
     high_poly: list | None = None
     cage: "bpy.types.Object | None" = None

@@ -9,8 +9,9 @@ import tempfile
 import bpy
 import numpy as np
 
-AO_NODE_LABEL = "HAO AO"
+AO_NODE_LABEL = "HAO AO"  # the AO image node's label (and the frame of the AO nodes)
 AO_MIX_LABEL = "HAO AO Multiply"
+ORM_NODE_LABEL = "HAO ORM"
 # The node group Blender's glTF exporter reads the Occlusion input of (io_scene_gltf2:
 # get_socket_from_gltf_material_node matches group names starting with this, any case), and
 # writes as the material's occlusionTexture on the UV map of the image's UV Map node.
@@ -32,46 +33,123 @@ def gltf_output_group() -> bpy.types.NodeTree:
     return group
 
 
-def wire_gltf_occlusion(tree: bpy.types.NodeTree, tex: bpy.types.Node) -> None:
-    """Connect the AO image node to the Occlusion input of the material's glTF Material
-    Output node (added once), so that glTF export writes it as occlusionTexture."""
+def _named_node(tree: bpy.types.NodeTree, bl_idname: str, name: str, frame: bpy.types.Node | None,
+                location: tuple[float, float], label: str = "") -> bpy.types.Node:
+    """The node called name (or, from an earlier release, labelled so), else a new one of that
+    type with that name, label and location, inside frame: an artist sees which nodes are ours,
+    and a bake again reuses them instead of stacking more."""
+    node = tree.nodes.get(name)
+    if node is None or node.bl_idname != bl_idname:
+        node = next((n for n in tree.nodes if n.bl_idname == bl_idname and n.label == (label or name)), None)
+    if node is None:
+        node = tree.nodes.new(bl_idname)
+        node.location = location
+    node.name, node.label = name, label or name
+    if frame is not None and node.parent is None:
+        node.parent = frame
+    return node
+
+
+def _image_nodes(tree: bpy.types.NodeTree, prefix: str, image: bpy.types.Image, uv_name: str,
+                 y: float) -> tuple[bpy.types.Node, bpy.types.Node]:
+    """(frame, image node) of one map: a frame '<prefix>' holding an Image Texture node
+    '<prefix> Image' labelled prefix, fed by a UV Map node '<prefix> UV Map' on uv_name."""
+    frame = _named_node(tree, 'NodeFrame', prefix, None, (-950, y + 120))
+    tex = _named_node(tree, 'ShaderNodeTexImage', f"{prefix} Image", frame, (-700, y), label=prefix)
+    uv_node = _named_node(tree, 'ShaderNodeUVMap', f"{prefix} UV Map", frame, (-900, y))
+    uv_node.uv_map = uv_name
+    if not any(link.from_node == uv_node for link in tex.inputs["Vector"].links):
+        tree.links.new(uv_node.outputs["UV"], tex.inputs["Vector"])
+    tex.image = image
+    return frame, tex
+
+
+def wire_gltf_occlusion(tree: bpy.types.NodeTree, socket: bpy.types.NodeSocket, frame: bpy.types.Node) -> None:
+    """Connect socket (the AO image's colour, or an ORM's red) to the Occlusion input of the
+    material's glTF Material Output node (one made, named 'HAO AO glTF Material Output', where
+    the material has none), so that glTF export writes it as occlusionTexture and renders
+    are not darkened by it."""
     group = gltf_output_group()
     node = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeGroup' and n.node_tree == group), None)
     if node is None:
-        node = tree.nodes.new('ShaderNodeGroup')
+        node = _named_node(tree, 'ShaderNodeGroup', f"{AO_NODE_LABEL} {GLTF_OUTPUT_GROUP}", frame, (-400, 420),
+                           label=GLTF_OUTPUT_GROUP)
         node.node_tree = group
-        node.label = GLTF_OUTPUT_GROUP
-        node.location = (tex.location.x + 300, tex.location.y + 250)
-    socket = node.inputs[GLTF_OCCLUSION]
-    if not any(link.from_node == tex for link in socket.links):
-        tree.links.new(tex.outputs["Color"], socket)
+    target = node.inputs[GLTF_OCCLUSION]
+    if not any(link.from_socket == socket for link in target.links):
+        tree.links.new(socket, target)
 
 
-ORM_NODE_LABEL = "HAO ORM"
+def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str,
+                       multiply_base_color: bool = False) -> bpy.types.Material:
+    """Add the AO map to the object's active material the way Blender's glTF exporter reads
+    it: an Image Texture node 'HAO AO Image' (the active node, through a UV Map node) into the
+    glTF Material Output's Occlusion socket, in a frame 'HAO AO'. Renders do not darken twice
+    (Cycles and EEVEE compute their own AO); multiply_base_color also multiplies it into the
+    Principled BSDF's Base Color once ('HAO AO Multiply'), and without it a multiply an earlier
+    bake added is taken out again. A material is created when the object has none."""
+    mat = obj.active_material
+    if mat is None:
+        mat = bpy.data.materials.new(f"{obj.name}_HAO")
+        obj.data.materials.append(mat)
+    if mat.node_tree is None:  # materials made before 5.0 may lack a node tree
+        mat.use_nodes = True
+    tree = mat.node_tree
+    frame, tex = _image_nodes(tree, AO_NODE_LABEL, image, uv_name, 300)
+    tree.nodes.active = tex
+    wire_gltf_occlusion(tree, tex.outputs["Color"], frame)
+    bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
+    if bsdf is not None and multiply_base_color:
+        _multiply_into(tree, bsdf.inputs["Base Color"], tex, frame)
+    elif bsdf is not None:
+        _take_out_multiply(tree, bsdf.inputs["Base Color"])
+    return mat
+
+
+def _multiply_into(tree, base: bpy.types.NodeSocket, tex: bpy.types.Node, frame: bpy.types.Node) -> None:
+    """Base Color = (what fed it) x AO, through one Mix node 'HAO AO Multiply'."""
+    if base.links and base.links[0].from_node.label == AO_MIX_LABEL:
+        return
+    mix = _named_node(tree, 'ShaderNodeMix', AO_MIX_LABEL, frame, (-400, 250))
+    mix.data_type = 'RGBA'
+    mix.blend_type = 'MULTIPLY'
+    mix.inputs[0].default_value = 1.0
+    a_in, b_in = mix.inputs[6], mix.inputs[7]  # the colour A and B sockets
+    if base.links:
+        tree.links.new(base.links[0].from_socket, a_in)
+    else:
+        a_in.default_value = base.default_value
+    tree.links.new(tex.outputs["Color"], b_in)
+    tree.links.new(mix.outputs[2], base)
+
+
+def _take_out_multiply(tree, base: bpy.types.NodeSocket) -> None:
+    """Undo _multiply_into: Base Color fed again by what fed the Multiply's A (or its value)."""
+    mix = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeMix' and n.label == AO_MIX_LABEL), None)
+    if mix is None:
+        return
+    a_in = mix.inputs[6]
+    if base.links and base.links[0].from_node == mix:
+        if a_in.links:
+            tree.links.new(a_in.links[0].from_socket, base)
+        else:
+            tree.links.remove(base.links[0])
+            base.default_value = a_in.default_value
+    tree.nodes.remove(mix)
 
 
 def wire_orm(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str) -> None:
     """Wire an ORM texture (R occlusion, G roughness, B metallic; core/bake/orm.py) into the
-    object's active material, as glTF export packs it: through a Separate Color node, R to the
-    glTF Material Output's Occlusion, G to the Principled BSDF's Roughness, B to its Metallic
-    (the exporter then writes one image as occlusionTexture and metallicRoughnessTexture).
-    Call after wire_into_material (which made the material's AO nodes)."""
+    object's active material, as glTF export packs it: in a frame 'HAO ORM', through a
+    Separate Color node, R to the glTF Material Output's Occlusion, G to the Principled BSDF's
+    Roughness, B to its Metallic (the exporter then writes one image as occlusionTexture and
+    metallicRoughnessTexture). Call after wire_into_material (which made the material's AO nodes)."""
     tree = obj.active_material.node_tree
-    tex = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeTexImage' and n.label == ORM_NODE_LABEL), None)
-    if tex is None:
-        tex = tree.nodes.new('ShaderNodeTexImage')
-        tex.label = ORM_NODE_LABEL
-        tex.location = (-700, -100)
-        uv_node = tree.nodes.new('ShaderNodeUVMap')
-        uv_node.location = (-900, -100)
-        uv_node.uv_map = uv_name
-        tree.links.new(uv_node.outputs["UV"], tex.inputs["Vector"])
-    tex.image = image
-    split = tree.nodes.new('ShaderNodeSeparateColor')
-    split.location = (-450, -100)
-    tree.links.new(tex.outputs["Color"], split.inputs[0])
-    group = next(n for n in tree.nodes if n.bl_idname == 'ShaderNodeGroup' and n.node_tree == gltf_output_group())
-    tree.links.new(split.outputs[0], group.inputs[GLTF_OCCLUSION])
+    frame, tex = _image_nodes(tree, ORM_NODE_LABEL, image, uv_name, -100)
+    split = _named_node(tree, 'ShaderNodeSeparateColor', f"{ORM_NODE_LABEL} Separate Color", frame, (-450, -100))
+    if not split.inputs[0].links:
+        tree.links.new(tex.outputs["Color"], split.inputs[0])
+    wire_gltf_occlusion(tree, split.outputs[0], frame)
     bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
     if bsdf is not None:
         tree.links.new(split.outputs[1], bsdf.inputs["Roughness"])
@@ -157,54 +235,6 @@ def image_pixels_gray(image: bpy.types.Image) -> np.ndarray:
     px = np.empty(w * h * 4, dtype=np.float32)
     image.pixels.foreach_get(px)
     return px.reshape(h, w, 4)[..., 0]
-
-
-def wire_into_material(obj: bpy.types.Object, image: bpy.types.Image, uv_name: str) -> bpy.types.Material:
-    """Add an Image Texture node with the AO map (through a UV Map node) to the object's
-    active material, make it the active node, multiply it into the Principled BSDF's Base
-    Color once and connect it to the glTF Material Output's Occlusion (what glTF export
-    writes as occlusionTexture). A material is created when the object has none."""
-    mat = obj.active_material
-    if mat is None:
-        mat = bpy.data.materials.new(f"{obj.name}_HAO")
-        obj.data.materials.append(mat)
-    if mat.node_tree is None:  # materials made before 5.0 may lack a node tree
-        mat.use_nodes = True
-    tree = mat.node_tree
-    tex = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeTexImage' and n.label == AO_NODE_LABEL), None)
-    if tex is None:
-        tex = tree.nodes.new('ShaderNodeTexImage')
-        tex.label = AO_NODE_LABEL
-        tex.location = (-700, 300)
-        uv_node = tree.nodes.new('ShaderNodeUVMap')
-        uv_node.location = (-900, 300)
-        uv_node.uv_map = uv_name
-        tree.links.new(uv_node.outputs["UV"], tex.inputs["Vector"])
-    else:
-        for link in tex.inputs["Vector"].links:
-            if link.from_node.bl_idname == 'ShaderNodeUVMap':
-                link.from_node.uv_map = uv_name
-    tex.image = image
-    tree.nodes.active = tex
-    wire_gltf_occlusion(tree, tex)
-    bsdf = next((n for n in tree.nodes if n.bl_idname == 'ShaderNodeBsdfPrincipled'), None)
-    has_mix = any(n.label == AO_MIX_LABEL for n in tree.nodes)
-    if bsdf is not None and not has_mix:
-        base = bsdf.inputs["Base Color"]
-        mix = tree.nodes.new('ShaderNodeMix')
-        mix.label = AO_MIX_LABEL
-        mix.data_type = 'RGBA'
-        mix.blend_type = 'MULTIPLY'
-        mix.location = (bsdf.location.x - 250, bsdf.location.y)
-        mix.inputs[0].default_value = 1.0
-        a_in, b_in = mix.inputs[6], mix.inputs[7]  # the colour A and B sockets
-        if base.links:
-            tree.links.new(base.links[0].from_socket, a_in)
-        else:
-            a_in.default_value = base.default_value
-        tree.links.new(tex.outputs["Color"], b_in)
-        tree.links.new(mix.outputs[2], base)
-    return mat
 
 
 # Image sources whose pixels come from a file on disk.
