@@ -26,11 +26,23 @@ def run(args, **kw):
 
 @pytest.fixture(scope="module")
 def built_zip(tmp_path_factory):
+    """The zip as a Windows or macOS user builds it: Python alone (-I -S: no site-packages,
+    so no bpy, no PYTHONPATH), the README's command."""
     out = tmp_path_factory.mktemp("dist")
-    proc = run([str(ROOT / "tools" / "build_extension.py"), str(out)])
+    proc = run(["-I", "-S", str(ROOT / "tools" / "build_extension.py"), str(out)])
     assert proc.returncode == 0, proc.stdout + proc.stderr
     (zip_path,) = out.glob("hao_ao-*.zip")
     return zip_path
+
+
+def test_the_builder_is_blender_s_own_and_validates_the_zip(built_zip):
+    """tools/blender_ext.py is the builder of the newest tested wheel, unchanged; Blender's
+    validation (the same tool as its bpy wheel ships) accepts the zip."""
+    shipped = Path(bpy.utils.system_resource('SCRIPTS')) / "addons_core" / "bl_pkg" / "cli" / "blender_ext.py"
+    if bpy.app.version[:2] == (5, 3):
+        assert (ROOT / "tools" / "blender_ext.py").read_bytes() == shipped.read_bytes()
+    proc = run(["-I", str(shipped), "validate", str(built_zip)])
+    assert proc.returncode == 0 and "Success" in proc.stdout + proc.stderr, proc.stdout + proc.stderr
 
 
 def test_zip_contains_the_extension_and_no_dev_files(built_zip):

@@ -3,9 +3,12 @@
 counts match, their links lead somewhere."""
 from __future__ import annotations
 
+import os
 import re
+import subprocess
 
 import numpy as np
+import pytest
 
 from conftest import ROOT
 
@@ -68,3 +71,42 @@ def test_bad_input_class_count_is_the_suite_s():
     assert stated == len(test_bad_input.CASES) + operator_cases
     accepted = int(re.search(r"and (\d+) classes of odd but valid input", COMMAND_LINE_PAGE).group(1))
     assert accepted == len(test_bad_input.ACCEPTED)
+
+
+@pytest.mark.release_independent  # it runs .venv's hao (the newest release) whichever suite runs it
+def test_readme_command_line_runs_as_typed(tmp_path):
+    """The README's command-line block, line by line as a newcomer types it (bash, in a folder
+    holding the repository's .venv, samples and tests, after what tools/sample.sh made): every
+    line exits 0, prints our own lines, and writes what it names."""
+    block = re.search(r"## A first bake on the command line.*?```sh\n(.*?)```", README, re.S)
+    assert block, "README lost its command-line block"
+    lines = [line.split("  #")[0].strip() for line in block.group(1).splitlines() if line.strip()]
+    assert lines and all(line.startswith(".venv/bin/hao ") for line in lines), lines
+    for name in (".venv", "samples", "tests"):
+        (tmp_path / name).symlink_to(ROOT / name)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    sample = [".venv/bin/python", "samples/make_scene.py", "out/spot_scene.blend"]  # as tools/sample.sh
+    assert subprocess.run(sample, cwd=tmp_path, env=env, capture_output=True).returncode == 0
+    for line in lines:
+        proc = subprocess.run(["bash", "-c", line], cwd=tmp_path, env=env, capture_output=True, text=True,
+                              timeout=600)
+        assert proc.returncode == 0 and proc.stdout.strip(), (line, proc.stdout, proc.stderr)
+        named = [w for w in line.split() if w.startswith("out/") and w != "out/spot_scene.blend"]
+        for path in named:
+            target = tmp_path / path
+            assert (target.is_dir() and any(target.iterdir())) or target.stat().st_size > 0, (line, path)
+
+
+def test_readme_pictures_read_on_light_and_dark_pages():
+    """The README's pictures are opaque, and what lies around their subject (the corners) is a
+    mid grey: a white map or a white cow on a transparent or white background is a faint smudge
+    on a light page (GitHub's default), and a black one vanishes on a dark page."""
+    import matplotlib.image as mpimg
+
+    pictures = re.findall(r"!\[[^\]]*\]\((docs/images/[^)]+\.png)\)", README)
+    assert len(pictures) >= 2, pictures
+    for picture in pictures:
+        pixels = mpimg.imread(ROOT / picture)
+        assert pixels.ndim == 3 and (pixels.shape[2] == 3 or pixels[..., 3].min() == 1.0), picture
+        corners = pixels[[0, 0, -1, -1], [0, -1, 0, -1], :3] if "viewport" not in picture else pixels[[0, 0], [0, -1], :3]
+        assert np.all((corners > 0.25) & (corners < 0.65)), (picture, corners)

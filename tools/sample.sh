@@ -7,10 +7,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 mkdir -p out
-.venv/bin/python -m hao_addon bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.png
-.venv/bin/python -m hao_addon bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.exr
+.venv/bin/hao bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.png
+.venv/bin/hao bake samples/spot.obj --size 1024 --directions 256 --out out/spot_ao.exr
 .venv/bin/python samples/make_scene.py out/spot_scene.blend
-.venv/bin/python -m hao_addon render-ao out/spot_scene.blend --camera Camera --width 800 --height 600 \
+.venv/bin/hao render-ao out/spot_scene.blend --camera Camera --width 800 --height 600 \
     --max-distance 0.5 --out out/spot_viewport_ao.png
 echo
 echo "Sample outputs:"

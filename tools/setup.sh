@@ -58,4 +58,11 @@ if ! "$venv/bin/python" -c "import bpy, xatlas, pytest, matplotlib" >/dev/null 2
   "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$req"
   cp "$req" "$venv/.requirements.installed"
 fi
+# The repository on the environment's path (as an editable install would put it) and a `hao`
+# command in it: `.venv/bin/hao bake ...` is `python -m hao_addon bake ...` from any folder.
+site="$("$venv/bin/python" -c "import sysconfig; print(sysconfig.get_path('purelib'))")"
+echo "$(pwd)" > "$site/hao_for_blender.pth"
+printf '#!%s\n# hao for Blender: the command line (python -m hao_addon), made by tools/setup.sh\nimport runpy\nrunpy.run_module("hao_addon", run_name="__main__", alter_sys=True)\n' \
+  "$(pwd)/$venv/bin/python" > "$venv/bin/hao"
+chmod +x "$venv/bin/hao"
 echo "$venv"
