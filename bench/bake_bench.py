@@ -224,20 +224,14 @@ def plot(results, path):
     """One time-against-error panel per row group and mesh (flat against the ray-traced
     reference, smooth and high-to-low against Cycles' own bake at high samples), plus the
     triangle sweep."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from plot_grid import panel_grid, save
     panels = [(f"{name} (flat)", m, "interior RMSE vs 1024-ray reference")
               for name, m in results.get("meshes", {}).items()]
     for group, label in (("smooth", "smooth"), ("high_to_low", "Selected to Active")):
         for name, m in results.get(group, {}).items():
             panels.append((f"{name} ({label})", m, f"interior RMSE vs Cycles {m['truth']['samples']} spp"))
     sweep = results.get("triangle_sweep")
-    count = len(panels) + (1 if sweep else 0)
-    cols = min(count, 3)
-    rows = -(-count // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(6 * cols, 4.8 * rows), squeeze=False)
-    axes = axes.ravel()
+    fig, axes = panel_grid(len(panels) + (1 if sweep else 0))
     styles = {"scatter": ("o-", "C0", "HAO scatter (McGraw & Sowers)"), "gather": ("s-", "C1", "HAO shadow-map gather"),
               "cycles": ("^-", "C2", "Cycles AO bake (CPU)")}
     for ax, (title, m, ylabel) in zip(axes, panels):
@@ -265,10 +259,7 @@ def plot(results, path):
         ax.set_title("cost against triangle count")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    for ax in axes[count:]:
-        ax.axis("off")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save(fig, path)
 
 
 def main() -> int:

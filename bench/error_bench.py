@@ -171,11 +171,9 @@ def main():
 
 
 def plot(results, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(results["meshes"]), figsize=(6 * len(results["meshes"]), 4.5))
-    for ax, (name, row) in zip(np.atleast_1d(axes), results["meshes"].items()):
+    from plot_grid import panel_grid, save
+    fig, axes = panel_grid(len(results["meshes"]))
+    for ax, (name, row) in zip(axes, results["meshes"].items()):
         for key, style in (("calibration", "o"), ("fixed", "s")):
             t = [r["seconds"] for r in row[key]]
             ax.loglog(t, [r["estimated"]["p99"] for r in row[key]], style + "-", label=f"{key}: estimated p99")
@@ -190,8 +188,7 @@ def plot(results, path):
         ax.set_xlabel("bake seconds (gather, 256^2)")
         ax.set_ylabel("p99 |error|")
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save(fig, path)
 
 
 if __name__ == "__main__":

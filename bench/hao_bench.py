@@ -355,6 +355,7 @@ def character_method_rows(renderer, objects, spheres, view_proj, count, rays, se
 
 
 def main() -> int:
+    global WIDTH, HEIGHT
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="fewer repeats and points (smoke test)")
     ap.add_argument("--out", default=str(ROOT / "bench" / "results"))
@@ -364,7 +365,6 @@ def main() -> int:
     ap.add_argument("--resolution", default=f"{WIDTH}x{HEIGHT}",
                     help="frame size WxH (tools/gpu_bench.sh: 1920x1080); the AO map is 1/scale of it")
     args = ap.parse_args()
-    global WIDTH, HEIGHT
     WIDTH, HEIGHT = (int(v) for v in args.resolution.split("x"))
     if args.plot_only:
         plot(json.loads((Path(args.out) / "hao_bench.json").read_text()), Path(args.out) / "hao_bench.png")
@@ -465,12 +465,9 @@ def _rmse_axes(ax, xlabel: str, ylabel: str, title: str, legend_size: int) -> No
 
 
 def plot(results, path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from plot_grid import panel_grid, save
     panels = [k for k in ("frame", "distances", "character_methods", "triangles") if k in results]
-    fig, axes = plt.subplots(1, max(len(panels), 1), figsize=(6 * max(len(panels), 1), 4.8), squeeze=False)
-    axes = axes.ravel()
+    fig, axes = panel_grid(len(panels))
     for ax, panel in zip(axes, panels):
         if panel == "frame":
             names = list(results["frame"])
@@ -508,8 +505,7 @@ def plot(results, path) -> None:
             ax.set_ylabel("ms")
             ax.set_title("Pass cost against triangle count")
             ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save(fig, path)
 
 
 if __name__ == "__main__":

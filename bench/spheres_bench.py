@@ -240,10 +240,8 @@ def main() -> int:
 
 
 def plot(res, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(17, 4.8))
+    from plot_grid import panel_grid, save
+    fig, axes = panel_grid(3)
     ax = axes[0]
     for k in sorted({r["k"] for r in res["sync_numpy"]}):
         rows = [r for r in res["sync_numpy"] if r["k"] == k]
@@ -271,8 +269,7 @@ def plot(res, path):
     ax.bar(list(off), [off[m]["rmse"] for m in off])
     ax.set_ylabel("RMSE")
     ax.set_title("Floor before a wall behind the camera")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save(fig, path)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "bench")]
+sys.path[:0] = [str(ROOT), str(ROOT / "bench"), str(ROOT / "tools")]
 os.environ["COLUMNS"] = "100"  # argparse's help width: the same text on every terminal
 
 from hao_addon.core.setting_spec import specs  # noqa: E402
@@ -31,6 +31,7 @@ from hao_addon.core.bake import abilities  # noqa: E402
 from hao_addon.core.bake.job_options import JobOptions  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.hao.view_settings import RenderSize, ViewAOSettings  # noqa: E402
+from bench_tables import results_tables  # noqa: E402
 
 DOCS = ROOT / "docs"
 RESULTS = ROOT / "bench" / "results"
@@ -153,47 +154,6 @@ def bench_description(stem: str) -> str:
     return " ".join(head.split()) + "\n\n" + ("Run: `" + "`, `".join(usage) + "`.\n\n" if usage else "") + prose
 
 
-def json_values(value, prefix: str = ""):
-    """(key path, value) of every value inside a JSON value that is not an object, objects
-    walked into."""
-    if isinstance(value, dict):
-        for key, item in value.items():
-            yield from json_values(item, f"{prefix}.{key}" if prefix else str(key))
-    else:
-        yield prefix, value
-
-
-def _is_records(value) -> bool:
-    return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
-
-
-def flat_rows(value, prefix: str = "") -> list[tuple[str, str]]:
-    """(key path, value) of a JSON value's scalars and short lists, for a two-column table
-    (lists of records are tables of their own: record_tables)."""
-    return [(path, ", ".join(_fmt(v) for v in item[:12]) + (" ..." if len(item) > 12 else "")
-             if isinstance(item, list) else _fmt(item))
-            for path, item in json_values(value, prefix) if not _is_records(item)]
-
-
-def record_tables(value, prefix: str = "") -> list[tuple[str, list[dict]]]:
-    """Every list of records (dicts) inside a JSON value, with its key path."""
-    return [(path, item) for path, item in json_values(value, prefix) if _is_records(item)]
-
-
-def _fmt(v) -> str:
-    if isinstance(v, float):
-        return f"{v:.4g}"
-    return str(v).replace("|", "/")
-
-
-def records_table(records: list[dict]) -> str:
-    keys = list(dict.fromkeys(k for r in records for k, v in r.items() if not isinstance(v, (dict, list))))
-    rows = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for r in records:
-        rows.append("| " + " | ".join(_fmt(r.get(k, "")) for k in keys) + " |")
-    return "\n".join(rows)
-
-
 def bench_section(stem: str, title: str) -> tuple[str, list[str]]:
     """A benchmark's section and the plots it shows."""
     description = bench_description(stem)
@@ -202,16 +162,12 @@ def bench_section(stem: str, title: str) -> tuple[str, list[str]]:
     plots = []
     if (RESULTS / f"{stem}.png").exists():
         plots.append(f"{stem}.png")
-        parts += [f"![{title}](benchmarks/{stem}.png)", ""]
+        parts += [f"[![{title}](benchmarks/{stem}.png)](benchmarks/{stem}.png)", ""]
     if stem in ("bake_bench", "hao_bench", "spheres_bench"):
         import report
         parts += [report.tables(data), ""]
     else:
-        for path, records in record_tables(data):
-            parts += [f"**{path}**", "", records_table(records), ""]
-        scalars = flat_rows(data)
-        if scalars:
-            parts += ["| value | |", "|---|---|"] + [f"| {k} | {v} |" for k, v in scalars] + [""]
+        parts += results_tables(data)
     return "\n".join(parts), plots
 
 
@@ -221,7 +177,12 @@ def benchmarks_page() -> tuple[str, list[str]]:
              "(`bench/results/*.json`; earlier runs stay in `bench/results/runs/`). Every "
              "number comes from its results file; each benchmark compares its rows in one run "
              "on one machine (2 CPU cores, Mesa llvmpipe, no GPU unless its machine line says "
-             "otherwise), as ratios, because timings on shared machines vary between runs.", ""]
+             "otherwise), as ratios, because timings on shared machines vary between runs.", "",
+             "How to read the ratios: a *ratio* of times is the first-named time over the second "
+             "(below 1: the first is faster); a *speed-up* is the other way round, the baseline's "
+             "time over this row's (above 1: faster; below 1: slower, 0.85 is 15 % slower). Error "
+             "ratios (*rmse ratio*, *p99 ratio*) are measured over stated: 1 is a stated error that "
+             "holds. Each plot opens at full size when clicked.", ""]
     plots = []
     for stem, title in BENCHES:
         if (RESULTS / f"{stem}.json").exists():
