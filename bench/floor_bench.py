@@ -39,7 +39,7 @@ import numpy as np  # noqa: E402
 
 from truth import Truth, bake_sample_points, reference_sample_points, texel_samples, truth_at  # noqa: E402
 
-MESHES = (ROOT / "samples" / "spot.obj", ROOT / "tests" / "data" / "rocker-arm.obj",
+MESHES = (ROOT / "tests" / "data" / "spot.obj", ROOT / "tests" / "data" / "rocker-arm.obj",
           ROOT / "bench" / "data" / "stanford-bunny.obj", ROOT / "tests" / "data" / "fandisk.obj")
 DIRECTIONS = {"gather": (64, 256, 1024, 4096, 16384), "scatter": (64, 256, 1024, 4096),
               "reference": (64, 256, 1024)}

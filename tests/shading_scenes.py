@@ -27,11 +27,11 @@ TRUTH_SPP = 1024
 # brighter on average, so that shading is baked both ways: spot_custom with the offset off,
 # spot_custom_default with Blender's default.
 CASES = {
-    "spot_smooth": (ROOT / "samples" / "spot.obj", "smooth"),
+    "spot_smooth": (DATA / "spot.obj", "smooth"),
     "rocker_smooth": (DATA / "rocker-arm.obj", "smooth"),
     "fandisk_sharp": (DATA / "fandisk.obj", "sharp"),
-    "spot_custom": (ROOT / "samples" / "spot.obj", "custom"),
-    "spot_custom_default": (ROOT / "samples" / "spot.obj", "custom"),
+    "spot_custom": (DATA / "spot.obj", "custom"),
+    "spot_custom_default": (DATA / "spot.obj", "custom"),
 }
 SHARP_ANGLE = math.radians(30.0)
 DEFAULT_TERMINATOR_OFFSET = 0.1  # Blender's default of Object.shadow_terminator_geometry_offset

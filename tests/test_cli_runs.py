@@ -61,8 +61,8 @@ def test_object_token_and_json_report(dirs):
     assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == "", proc.stderr
     assert (out / "spot_ao.exr").is_file() and not list(out.glob("{*"))
     data = json.loads(report.read_text())
-    # Spot's UVs reach past 0 (a warning below): done, with something to look at.
-    assert data["status"] == "warning" and data["exit_code"] == 0 and data["error"] is None
+    # The bundled sample bakes without a warning of its own: status ok.
+    assert data["status"] == "ok" and data["exit_code"] == 0 and data["error"] is None and data["warnings"] == []
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
@@ -74,7 +74,12 @@ def test_object_token_and_json_report(dirs):
     # An OBJ carries no terminator offset of its own: --terminator-offset (default 0.1) applies.
     assert data["settings"]["terminator"] == "setting" and data["settings"]["terminator_offset"] == 0.1
     assert {"load", "bake", "write", "total", "unwrap"} <= set(data["timings"])
-    assert any("outside the 0..1 UV tile" in w for w in data["warnings"])  # Spot's UVs reach past 0
+    # Spot as published reaches 0.052 past the tile's left edge: done, with something to look at.
+    proc = run(["bake", ROOT / "tests" / "data" / "spot.obj", "--size", "64", "--directions", "8", "--out",
+                out / "o.png", "--json", report, "--quiet"], tmp)
+    data = json.loads(report.read_text())
+    assert proc.returncode == 0 and data["status"] == "warning" and data["exit_code"] == 0
+    assert any("outside the 0..1 UV tile" in w for w in data["warnings"])
     # '-' writes the report to stdout, and a failure is reported too (with nothing else written).
     proc = run(["bake", SPOT, "--size", "8", "--out", out / "x.png", "--json", "-"], tmp)
     data = json.loads(proc.stdout)
@@ -235,6 +240,29 @@ def test_progress_on_a_terminal_and_not_when_quiet(dirs):
     finally:
         os.close(master)
     assert proc.returncode == 0 and text == ""
+
+
+def test_progress_on_a_log_is_a_line_every_ten_seconds(monkeypatch):
+    """stderr redirected to a log: nothing for a run under Progress.LOG_INTERVAL, then one whole
+    line (no carriage returns) each interval, so a long farm or pipeline bake shows it is
+    alive; --quiet (enabled False) prints nothing."""
+    import io as text_io
+
+    from hao_addon.cli import io as cli_io
+    clock = [100.0]
+    monkeypatch.setattr(cli_io.time, "perf_counter", lambda: clock[0])
+    log, quiet = text_io.StringIO(), text_io.StringIO()
+    progress = cli_io.Progress(log, enabled=True, terminal=False)
+    silent = cli_io.Progress(quiet, enabled=False, terminal=False)
+    for step in range(0, 351):  # 35 s of a bake, an update every 0.1 s
+        clock[0] = 100.0 + step / 10.0
+        for p in (progress, silent):
+            p.update("Baking AO of 'spot'", step / 350.0)
+    progress.finish()
+    lines = log.getvalue().splitlines()
+    assert len(lines) == 3 and "\r" not in log.getvalue() and quiet.getvalue() == "", lines
+    assert lines[0].startswith("hao: Baking AO of 'spot'  29% (") and lines[0].endswith(" s left)"), lines
+    assert [line.split("%")[0][-3:] for line in lines] == [" 29", " 57", " 86"]
 
 
 def big_sphere_obj(path: Path, segments: int = 640, rings: int = 320) -> Path:

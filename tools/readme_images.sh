@@ -10,8 +10,9 @@ cd "$(dirname "$0")/.."
 mkdir -p docs/images
 .venv/bin/python -m hao_addon bake samples/spot.obj --size 256 --directions 256 --margin 4 \
     --out docs/images/spot_ao.png --bent-normal-out docs/images/spot_bent_normals.png
-.venv/bin/python tools/readme_pictures.py
 # The viewport picture: HAO of Spot on a floor from the sample scene's camera (tools/sample.sh).
 .venv/bin/python samples/make_scene.py out/spot_scene.blend
 .venv/bin/python -m hao_addon render-ao out/spot_scene.blend --camera Camera --width 640 --height 480 \
     --max-distance 0.5 --out docs/images/spot_viewport_ao.png
+# Then the pictures made in Python, and both above set on a mid-grey background.
+.venv/bin/python tools/readme_pictures.py

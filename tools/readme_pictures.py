@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The README's pictures of the colour-attribute and UDIM outputs (tools/readme_images.sh
-runs it after the command-line bakes):
+"""The README's pictures of the colour-attribute and UDIM outputs, and the command-line
+bakes' pictures set on a mid-grey background (tools/readme_images.sh runs it after them):
 
     docs/images/spot_color_attribute.png  Spot's per-vertex AO (hao_ao, 256 directions) as
                                           Workbench renders the colour attribute, flat lit,
@@ -8,6 +8,12 @@ runs it after the command-line bakes):
     docs/images/udim_tiles.png            a ball, a floor and a second ball baked onto UDIM
                                           tiles 1001, 1002, 1011 (one pass), laid out as the
                                           tiles sit in UV space (1012 unused, dark)
+    docs/images/spot_ao.png               the AO map, texels outside Spot's UV islands (and
+                                          their margins) in BACKGROUND grey
+    docs/images/spot_viewport_ao.png      the viewport AO render over BACKGROUND grey (it is
+                                          transparent where no surface is)
+A white map or a white cow on a transparent or white background is a faint smudge on a light
+page; on a mid grey both read on light and dark pages.
 """
 from __future__ import annotations
 
@@ -29,10 +35,34 @@ from hao_addon.core import scenes  # noqa: E402
 from hao_addon.core.bake.settings import BakeSettings  # noqa: E402
 from hao_addon.core.geometry import TriangleSoup  # noqa: E402
 from hao_addon.core.imageio import write_ao_file  # noqa: E402
-from hao_addon.core.objfile import read_obj  # noqa: E402
+from hao_addon.core.objfile import obj_soup, read_obj  # noqa: E402
 from hao_addon.gpu.context import ensure_gpu_context  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
+BACKGROUND = 0.42  # a mid grey (sRGB 107): reads on a light page and on a dark one
+
+
+def on_background(path: Path, inside: np.ndarray | None = None) -> None:
+    """Rewrite the picture at path (8-bit RGB) over BACKGROUND: where its alpha is 0, or, for
+    a grey map, outside inside ((H, W) bool, row 0 at the top)."""
+    import matplotlib.image as mpimg
+
+    pixels = mpimg.imread(path).astype(np.float32)
+    if pixels.ndim == 2:
+        pixels = np.repeat(pixels[..., None], 3, axis=2)
+    if pixels.shape[2] == 4:
+        alpha, pixels = pixels[..., 3:], pixels[..., :3]
+    else:
+        alpha = inside[..., None].astype(np.float32)
+    picture = pixels * alpha + BACKGROUND * (1.0 - alpha)
+    mpimg.imsave(path, np.clip(picture, 0.0, 1.0))
+
+
+def map_islands(obj: Path, size: int, margin: int) -> np.ndarray:
+    """(size, size) bool, row 0 at the top: the texels a bake of obj's own UVs fills (its
+    islands and their margins); one direction is enough, only the layout counts."""
+    filled = bake(obj_soup(obj), [], BakeSettings(size=size, directions=1, margin=margin)).filled
+    return np.flipud(filled.astype(bool))
 
 
 def color_attribute_picture(path: Path) -> None:
@@ -91,4 +121,7 @@ if __name__ == "__main__":
     IMAGES.mkdir(parents=True, exist_ok=True)
     color_attribute_picture(IMAGES / "spot_color_attribute.png")
     udim_picture(IMAGES / "udim_tiles.png")
-    print("wrote", IMAGES / "spot_color_attribute.png", IMAGES / "udim_tiles.png")
+    on_background(IMAGES / "spot_ao.png", map_islands(ROOT / "samples" / "spot.obj", 256, 4))
+    if (IMAGES / "spot_viewport_ao.png").is_file():
+        on_background(IMAGES / "spot_viewport_ao.png")
+    print("wrote", IMAGES / "spot_color_attribute.png", IMAGES / "udim_tiles.png", "and the grey backgrounds")

@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
             if getattr(args, "progress", "") == "openjd":  # a farm task: its progress for the farm
                 progress = OpenJDProgress(io.out)
             else:
-                progress = Progress(io.err, enabled=io.err_is_terminal and not args.quiet)
+                progress = Progress(io.err, enabled=not args.quiet, terminal=io.err_is_terminal)
             try:
                 lines = COMMANDS[args.command](args, report, progress)
             finally:

@@ -139,15 +139,19 @@ def exit_process(code: int) -> None:
 
 
 class Progress:
-    """One self-overwriting line on a terminal's stderr ("hao: baking 'Spot' 45% (2.1 s left)"),
-    shown once a run has lasted SHOW_AFTER seconds; nothing when disabled."""
+    """Progress on stderr ("hao: baking 'Spot' 45% (2.1 s left)"): on a terminal one
+    self-overwriting line, shown once a run has lasted SHOW_AFTER seconds; on a log (stderr not
+    a terminal: a farm's or a pipeline's redirect) a whole line every LOG_INTERVAL seconds once
+    the run has lasted that long, so a long bake shows it is alive; nothing when disabled."""
 
     SHOW_AFTER = 1.0
     MIN_INTERVAL = 0.1
+    LOG_INTERVAL = 10.0
 
-    def __init__(self, stream: TextIO | None, enabled: bool) -> None:
+    def __init__(self, stream: TextIO | None, enabled: bool, terminal: bool = True) -> None:
         self.stream = stream
         self.enabled = enabled and stream is not None
+        self.terminal = terminal
         self.start = time.perf_counter()
         self._last = 0.0
         self._shown = False
@@ -161,16 +165,25 @@ class Progress:
         now = time.perf_counter()
         if phase != self._phase:
             self._phase, self._phase_start = phase, now
-        if not self.enabled or now - self.start < self.SHOW_AFTER or now - self._last < self.MIN_INTERVAL:
+        if not self.enabled or not self._due(now):
             return
         self._last = now
         text = f"hao: {phase}"
         if fraction is not None and fraction > 0.0:
             left = (now - self._phase_start) * (1.0 - fraction) / fraction
             text += f" {fraction * 100:3.0f}% ({left:.1f} s left)"
+        if not self.terminal:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+            return
         self._shown = True  # first: a signal during the write must still get the line cleared
         self.stream.write("\r\033[K" + text)
         self.stream.flush()
+
+    def _due(self, now: float) -> bool:
+        if not self.terminal:
+            return now - max(self.start, self._last) >= self.LOG_INTERVAL
+        return now - self.start >= self.SHOW_AFTER and now - self._last >= self.MIN_INTERVAL
 
     def share(self, index: int, count: int) -> None:
         """A batch: input index of count starts (the terminal line shows each input's own)."""

@@ -41,7 +41,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--chunk", type=int, default=None, help="with --manifest: the chunk to bake (0 is the first)")
     b.add_argument("--input-root", default=None, metavar="DIR", help="with --manifest: the folder of its inputs")
     b.add_argument("--progress", choices=("terminal", "openjd"), default="terminal",
-                   help="terminal: a progress line on a terminal; openjd: 'openjd_progress: P' lines on stdout "
+                   help="terminal: a progress line on a terminal, or, with stderr redirected to a log, a line every 10 s once "
+                        "a run has lasted 10 s; openjd: 'openjd_progress: P' lines on stdout "
                         "(Open Job Description's form, for farm tasks)")
     add_run_options(b)
 
