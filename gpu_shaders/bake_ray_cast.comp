@@ -3,25 +3,19 @@
  * cell with a 3D DDA; the twin of mathutils' BVH ray cast in core/bake/projection.py).
  *
  * Everything is in cell units (world - grid lo) / cell side: cell (x, y, z) spans [x, x + 1)
- * and so on, and the grid's box is [0, dims]. One invocation per ray; ray r's data sit at
- * texel (r % LIST_WIDTH, r / LIST_WIDTH) of each list texture. Integers (cell ranges,
- * triangle indices, the hit face) travel as float bits: only FLOAT buffers upload.
+ * and so on, and the grid's box is [0, dims]. One invocation per ray; ray r's data are entry r
+ * of each list, read with gpu/list_inputs.py's macros (list textures or storage buffers).
  *
  * Output hit_out: (face as int bits, -1 for a miss; t; u; v): the hit is
  * (1 - u - v) v0 + u v1 + v v2 at origin + t * direction. */
-
-ivec2 list_texel(int i)
-{
-  return ivec2(i % LIST_WIDTH, i / LIST_WIDTH);
-}
 
 /* Moller-Trumbore, both sides: (t, u, v) of the hit, t < 0 for none. A ray through a shared
  * edge may report both triangles (EDGE_SLACK keeps it from slipping between them). */
 vec3 intersect(vec3 origin, vec3 dir, int face)
 {
-  vec3 v0 = texelFetch(tri_corners, list_texel(3 * face), 0).xyz;
-  vec3 e1 = texelFetch(tri_corners, list_texel(3 * face + 1), 0).xyz;
-  vec3 e2 = texelFetch(tri_corners, list_texel(3 * face + 2), 0).xyz;
+  vec3 v0 = LIST_VEC4(tri_corners, 3 * face).xyz;
+  vec3 e1 = LIST_VEC4(tri_corners, 3 * face + 1).xyz;
+  vec3 e2 = LIST_VEC4(tri_corners, 3 * face + 2).xyz;
   vec3 p = cross(dir, e2);
   float det = dot(e1, p);
   if (det == 0.0) {
@@ -44,9 +38,8 @@ void main()
   if (ray >= ray_end) {
     return;
   }
-  ivec2 at = list_texel(ray);
-  vec3 origin = texelFetch(ray_origin, at, 0).xyz;
-  vec3 dir = texelFetch(ray_direction, at, 0).xyz;
+  vec3 origin = LIST_VEC4(ray_origin, ray).xyz;
+  vec3 dir = LIST_VEC4(ray_direction, ray).xyz;
   vec4 result = vec4(intBitsToFloat(-1), 0.0, 0.0, 0.0);
   vec3 box = vec3(dims);
   /* A zero component steps never: a huge but finite inverse keeps 0 * inf NaNs out. */
@@ -59,7 +52,7 @@ void main()
   float t_enter = max(max(max(t_near.x, t_near.y), t_near.z), 0.0);
   float t_exit = min(min(min(t_far.x, t_far.y), t_far.z), reach);
   if (dot(dir, dir) == 0.0 || t_enter > t_exit) {
-    imageStore(hit_out, at, result);
+    LIST_STORE(hit_out, ray, result);
     return;
   }
   ivec3 cell = clamp(ivec3(floor(origin + dir * t_enter)), ivec3(0), dims - 1);
@@ -72,10 +65,10 @@ void main()
   vec2 best_uv = vec2(0.0);
   for (int visited = 0; visited < dims.x + dims.y + dims.z; visited++) {
     int c = (cell.z * dims.y + cell.y) * dims.x + cell.x;
-    int first = int(floatBitsToUint(texelFetch(cell_start, list_texel(c), 0).r));
-    int last = int(floatBitsToUint(texelFetch(cell_start, list_texel(c + 1), 0).r));
+    int first = int(LIST_UINT(cell_start, c));
+    int last = int(LIST_UINT(cell_start, c + 1));
     for (int k = first; k < last; k++) {
-      int face = int(floatBitsToUint(texelFetch(cell_triangles, list_texel(k), 0).r));
+      int face = int(LIST_UINT(cell_triangles, k));
       vec3 hit = intersect(origin, dir, face);
       if (hit.x >= 0.0 && hit.x <= best && (hit.x < best || face < best_face || best_face < 0)) {
         best = hit.x;
@@ -108,5 +101,5 @@ void main()
   if (best_face >= 0) {
     result = vec4(intBitsToFloat(best_face), best, best_uv);
   }
-  imageStore(hit_out, at, result);
+  LIST_STORE(hit_out, ray, result);
 }

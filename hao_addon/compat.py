@@ -76,3 +76,23 @@ def set_shader_inputs(shader, samplers: dict, ints: dict | None = None, floats: 
         shader.uniform_int(name, value)
     for name, value in (floats or {}).items():
         shader.uniform_float(name, value)
+
+
+def storage_buffers() -> bool:
+    """Whether this Blender's gpu module has storage buffers (5.3 and newer: GPUStorageBuf,
+    GPUShaderCreateInfo.storage_buf, GPUShader.storage_block); gpu/list_inputs.py then keeps
+    a compute pass's lists in them instead of list textures."""
+    import gpu
+    return (hasattr(gpu.types, "GPUStorageBuf") and hasattr(gpu.types.GPUShaderCreateInfo, "storage_buf")
+            and hasattr(gpu.types.GPUShader, "storage_block"))
+
+
+def declare_storage_list(info, slot: int, glsl_type: str, name: str, write: bool) -> None:
+    """Declare a storage buffer `glsl_type name[]` (5.3's storage_buf), read-only unless write."""
+    info.storage_buf(slot, glsl_type, f"{name}[]", qualifiers={'WRITE'} if write else {'READ'})
+
+
+def storage_buffer(data) -> object:
+    """A storage buffer holding data (a gpu.types.Buffer), 5.3's GPUStorageBuf."""
+    import gpu
+    return gpu.types.GPUStorageBuf(data)

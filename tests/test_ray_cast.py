@@ -16,13 +16,20 @@ from hao_addon.core.bake import ray_grid
 from hao_addon.core.steps import drain
 from hao_addon.core.bake.ray_grid import build_grid
 from hao_addon.core.objfile import read_obj
+from hao_addon.gpu import list_inputs
 from hao_addon.gpu.util import live_pass_count
 
 ROCKER_OBJ = Path(__file__).parent / "data" / "rocker-arm.obj"
 
 
 def cast_both(origins, dirs, tri, reach):
-    return [drain(ray_caster_for(name)(origins, dirs, tri, reach)) for name in RAY_CASTS]
+    """The CPU's cast, then the GPU's in each list form this Blender has (textures; storage
+    buffers from 5.3 on: gpu/list_inputs.py)."""
+    casts = [drain(ray_caster_for("cpu")(origins, dirs, tri, reach))]
+    for form in list_inputs.available_forms():
+        with list_inputs.using_form(form):
+            casts.append(drain(ray_caster_for("gpu")(origins, dirs, tri, reach)))
+    return casts
 
 
 def surface_rays(tri: np.ndarray, count: int, standoff: float, seed: int = 0):
@@ -73,15 +80,19 @@ def test_gpu_cast_equals_cpu_cast_on_the_rocker_arm(gpu_context):
     size = float(np.ptp(v, axis=0).max())
     origins, dirs = surface_rays(tri, 60_000, 0.01 * size)
     passes = live_pass_count()
-    (cf, cb), (gf, gb) = cast_both(origins, dirs, tri, 0.0)
-    assert live_pass_count() == passes
+    (cf, cb), *gpu_casts = cast_both(origins, dirs, tri, 0.0)
+    assert live_pass_count() == passes and len(gpu_casts) == len(list_inputs.available_forms())
     assert (cf >= 0).mean() > 0.95
-    same = cf == gf
-    assert same.mean() > 0.9995, f"{(~same).sum()} rays differ"
-    pc = np.einsum("mk,mkd->md", cb[same & (cf >= 0)], tri[cf[same & (cf >= 0)]])
-    pg = np.einsum("mk,mkd->md", gb[same & (gf >= 0)], tri[gf[same & (gf >= 0)]])
-    gap = np.linalg.norm(pc - pg, axis=1)
-    assert np.quantile(gap, 0.999) < 1e-6 * size and gap.max() < 1e-4 * size
+    for gf, gb in gpu_casts:
+        same = cf == gf
+        assert same.mean() > 0.9995, f"{(~same).sum()} rays differ"
+        pc = np.einsum("mk,mkd->md", cb[same & (cf >= 0)], tri[cf[same & (cf >= 0)]])
+        pg = np.einsum("mk,mkd->md", gb[same & (gf >= 0)], tri[gf[same & (gf >= 0)]])
+        gap = np.linalg.norm(pc - pg, axis=1)
+        assert np.quantile(gap, 0.999) < 1e-6 * size and gap.max() < 1e-4 * size
+    for gf, gb in gpu_casts[1:]:  # the forms differ in how the lists are read, not in what is computed
+        np.testing.assert_array_equal(gf, gpu_casts[0][0])
+        np.testing.assert_array_equal(gb, gpu_casts[0][1])
 
 
 def test_gpu_cast_equals_cpu_cast_from_outside_and_within_a_max_distance(gpu_context):
@@ -96,10 +107,10 @@ def test_gpu_cast_equals_cpu_cast_from_outside_and_within_a_max_distance(gpu_con
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     dirs[::97] = 0.0  # zero directions find nothing
     for reach in (0.0, 6.0):
-        (cf, _), (gf, _) = cast_both(origins, dirs, tri, reach)
-        assert (cf[::97] < 0).all() and (gf[::97] < 0).all()
-        assert 0.2 < (cf >= 0).mean() < 0.9
-        assert (cf == gf).mean() > 0.9995
+        (cf, _), *gpu_casts = cast_both(origins, dirs, tri, reach)
+        assert 0.2 < (cf >= 0).mean() < 0.9 and (cf[::97] < 0).all()
+        for gf, _gb in gpu_casts:
+            assert (gf[::97] < 0).all() and (cf == gf).mean() > 0.9995
 
 
 @pytest.mark.parametrize("cast_name", RAY_CASTS)
@@ -107,3 +118,22 @@ def test_no_rays_cast_nothing(gpu_context, cast_name):
     face, bary = drain(ray_caster_for(cast_name)(np.zeros((0, 3)), np.zeros((0, 3)),
                                                   scenes.grid_plane(1.0, 1).positions, 0.0))
     assert face.shape == (0,) and bary.shape == (0, 3)
+
+
+def test_storage_buffers_exist_where_blender_has_them_and_textures_stay_chosen(gpu_context):
+    """Blender 5.3's storage buffers (compat.storage_buffers) are a list form there (cast above
+    against the CPU); the passes keep textures, measured faster on llvmpipe (list_inputs.
+    PREFERRED); on older releases textures are the only form and storage is refused."""
+    import bpy
+
+    from hao_addon import compat
+    has = bpy.app.version >= (5, 3, 0)
+    assert compat.storage_buffers() == has
+    assert list_inputs.available_forms() == (("textures", "storage") if has else ("textures",))
+    assert list_inputs.chosen_form().name == "textures"
+    if has:
+        with list_inputs.using_form("storage"):
+            assert list_inputs.chosen_form().name == "storage"
+    else:
+        with pytest.raises(ValueError, match="5.3"), list_inputs.using_form("storage"):
+            pass

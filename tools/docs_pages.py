@@ -52,6 +52,7 @@ BENCHES = [("bake_bench", "Bake: time against error, beside Cycles"),
            ("farm_bench", "Farm tasks"),
            ("groups_bench", "Bake groups matched by name"),
            ("alpha_bench", "Alpha-aware occluders"),
+           ("list_forms_bench", "Lists as textures or storage buffers (Blender 5.3)"),
            ("regression_bench", "Same-run regression check")]
 
 

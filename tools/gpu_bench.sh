@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The benchmarks on a machine with an NVIDIA GPU, headless over EGL: the bake's time against
 # error (bench/bake_bench.py, HAO beside Cycles' CPU bake, flat rows) and the viewport's frame
-# time at 1080p (bench/hao_bench.py's frame part), their JSON and plots into one folder.
+# time at 1080p (bench/hao_bench.py's frame part), and the ray cast's list forms (textures
+# against Blender 5.3's storage buffers, bench/list_forms_bench.py), their JSON and plots into one folder.
 #
 #     bash tools/gpu_bench.sh [OUT]        # OUT: bench/results/gpu (default)
 #
@@ -26,7 +27,7 @@ python="$venv/bin/python"
 import sys
 sys.path.insert(0, ".")
 import bpy, gpu
-from hao_addon.blender.gpu_context import ensure_gpu_context
+from hao_addon.gpu.context import ensure_gpu_context
 ensure_gpu_context()
 renderer = gpu.platform.renderer_get()
 print("renderer:", renderer, "| vendor:", gpu.platform.vendor_get(), "| backend:", gpu.platform.backend_type_get())
@@ -35,4 +36,5 @@ if "llvmpipe" in renderer.lower() or "lavapipe" in renderer.lower():
 PY
 "$python" bench/bake_bench.py --parts flat --meshes rocker-arm,bunny --out "$out"
 "$python" bench/hao_bench.py --parts frame --resolution 1920x1080 --out "$out"
-echo "gpu_bench: wrote $out/bake_bench.json and $out/hao_bench.json"
+"$python" bench/list_forms_bench.py --out "$out"  # list textures against 5.3's storage buffers
+echo "gpu_bench: wrote $out/bake_bench.json, $out/hao_bench.json and $out/list_forms_bench.json"

@@ -14,11 +14,10 @@ from typing import Generator
 import gpu
 import numpy as np
 
-from .. import compat
 from ..core.bake.projection import barycentric_from_uv
 from ..core.bake.ray_grid import UniformGrid, build_grid
 from ..core.errors import BakeInputError
-from . import util
+from . import list_inputs, util
 from .shaders import cached_shader, glsl_source, shader_variants
 
 LIST_WIDTH = util.LIST_WIDTH  # the list textures' rows; the compute grid is LIST_WIDTH / GROUP_SIZE wide
@@ -31,7 +30,13 @@ RAYS_PER_DISPATCH = 32 * LIST_WIDTH
 EDGE_SLACK = 1e-6
 
 
-def _ray_cast_info() -> "gpu.types.GPUShaderCreateInfo":
+# The pass's lists: (name, kind) in their slot order; hit_out is written.
+LIST_INPUTS = (("tri_corners", "VEC4"), ("cell_start", "UINT"), ("cell_triangles", "UINT"),
+               ("ray_origin", "VEC4"), ("ray_direction", "VEC4"))
+
+
+def _ray_cast_info(form_name: str) -> "gpu.types.GPUShaderCreateInfo":
+    form = list_inputs.FORMS[form_name]
     info = gpu.types.GPUShaderCreateInfo()
     info.local_group_size(GROUP_SIZE, 1, 1)
     info.define("LIST_WIDTH", str(LIST_WIDTH))
@@ -40,59 +45,55 @@ def _ray_cast_info() -> "gpu.types.GPUShaderCreateInfo":
     info.push_constant('INT', "ray_end")
     info.push_constant('IVEC3', "dims")
     info.push_constant('FLOAT', "reach")
-    info.sampler(0, 'FLOAT_2D', "tri_corners")
-    info.sampler(1, 'FLOAT_2D', "cell_start")
-    info.sampler(2, 'FLOAT_2D', "cell_triangles")
-    info.sampler(3, 'FLOAT_2D', "ray_origin")
-    info.sampler(4, 'FLOAT_2D', "ray_direction")
-    info.image(0, 'RGBA32F', 'FLOAT_2D', "hit_out", qualifiers={'WRITE'})
-    info.compute_source(glsl_source("bake_ray_cast.comp"))
+    for slot, (name, kind) in enumerate(LIST_INPUTS):
+        form.declare(info, slot, name, kind)
+    form.declare(info, len(LIST_INPUTS) if form_name == "storage" else 0, "hit_out", "VEC4", write=True)
+    info.compute_source(form.prelude() + glsl_source("bake_ray_cast.comp"))
     return info
 
 
-@shader_variants()
-def ray_cast_shader() -> "gpu.types.GPUShader":
-    return cached_shader(("bake_ray_cast",), _ray_cast_info)
+@shader_variants(valid=lambda arguments: arguments["form_name"] in list_inputs.available_forms(),
+                 form_name=list_inputs.FORM_NAMES)
+def ray_cast_shader(form_name: str = "textures") -> "gpu.types.GPUShader":
+    return cached_shader(("bake_ray_cast", form_name), lambda: _ray_cast_info(form_name))
 
 
-def list_texture(values: np.ndarray, fmt: str) -> "gpu.types.GPUTexture":
-    """util.list_texture, refused with one message beyond the GPU's texture size."""
-    if util.list_rows(len(values)) > gpu.capabilities.max_texture_size_get():
-        raise BakeInputError(f"the Selected-to-Active projection needs {len(values)} list entries, above this "
-                             f"GPU's texture limit: use a smaller map or fewer high-poly triangles")
-    return util.list_texture(values, fmt)
+def check_capacity(form, count: int) -> None:
+    """Refuse, with one message, a list longer than the form can hold."""
+    if count > form.capacity():
+        raise BakeInputError(f"the Selected-to-Active projection needs {count} list entries, above this "
+                             f"GPU's limit for {form.name}: use a smaller map or fewer high-poly triangles")
 
 
 class GpuRayCast(util.GPUPass):
-    """Owns the grid's and one batch of rays' textures."""
+    """Owns the grid's and one batch of rays' lists (in form: gpu/list_inputs.py)."""
 
-    def __init__(self, grid: UniformGrid, origins: np.ndarray, directions: np.ndarray) -> None:
+    def __init__(self, grid: UniformGrid, origins: np.ndarray, directions: np.ndarray, form=None) -> None:
         super().__init__()
+        self.form = form or list_inputs.chosen_form()
         tri = grid.local_triangles.astype(np.float64)
         corners = np.stack([tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]], axis=1)  # v0, e1, e2
         quads = np.zeros((len(tri) * 3, 4), np.float32)
         quads[:, :3] = corners.reshape(-1, 3)
-        self.tri_corners = list_texture(quads, 'RGBA32F')
-        self.cell_start = list_texture(grid.cell_start, 'R32F')
-        self.cell_triangles = list_texture(grid.triangle_index, 'R32F')
         rays = np.zeros((len(origins), 4))
         rays[:, :3] = grid.to_local(origins)
-        self.ray_origin = list_texture(rays, 'RGBA32F')
-        rays[:, :3] = directions
-        self.ray_direction = list_texture(rays, 'RGBA32F')
-        self.hit = gpu.types.GPUTexture((LIST_WIDTH, util.list_rows(len(origins))), format='RGBA32F')
+        aims = np.zeros((len(origins), 4))
+        aims[:, :3] = directions
+        values = {"tri_corners": quads, "cell_start": grid.cell_start, "cell_triangles": grid.triangle_index,
+                  "ray_origin": rays, "ray_direction": aims}
+        for name, _kind in LIST_INPUTS:
+            check_capacity(self.form, len(values[name]))
+        self.lists = {name: self.form.upload(values[name], kind) for name, kind in LIST_INPUTS}
+        self.hit = self.form.output(len(origins))
         self.grid, self.ray_count = grid, len(origins)
 
     def dispatch(self, first: int, end: int, reach: float) -> None:
-        """Cast rays first..end (their rows of the list; invocations past end return)."""
-        shader = ray_cast_shader()
+        """Cast rays first..end (their entries of the lists; invocations past end return)."""
+        shader = ray_cast_shader(self.form.name)
         shader.bind()
-        names = ("tri_corners", "cell_start", "cell_triangles", "ray_origin", "ray_direction")
-        compat.set_shader_inputs(shader, samplers={name: getattr(self, name) for name in names},
-                                 ints={"first_ray": first, "ray_end": end,
-                                       "dims": tuple(int(d) for d in self.grid.dims)},
-                                 floats={"reach": reach})
-        shader.image("hit_out", self.hit)
+        self.form.bind(shader, self.lists, {"hit_out": self.hit},
+                       ints={"first_ray": first, "ray_end": end, "dims": tuple(int(d) for d in self.grid.dims)},
+                       floats={"reach": reach})
         rows = -(-(end - first) // LIST_WIDTH)
         gpu.compute.dispatch(shader, LIST_WIDTH // GROUP_SIZE, rows, 1)
         gpu.shader.unbind()
@@ -100,13 +101,13 @@ class GpuRayCast(util.GPUPass):
     def hits(self) -> tuple[np.ndarray, np.ndarray]:
         """(face (m,) int64, -1 a miss; uv (m, 2) of the hit in that face) of every ray (the
         shader's t, hit_out.y, is for debugging: the point is the face's at uv)."""
-        out = util.texture_to_numpy(self.hit).reshape(-1, 4)[:self.ray_count]
+        out = self.form.read(self.hit, self.ray_count)
         face = out[:, 0].copy().view(np.int32).astype(np.int64)
         return face, out[:, 2:].astype(np.float64)
 
     def _release(self) -> None:
-        self.tri_corners = self.cell_start = self.cell_triangles = None
-        self.ray_origin = self.ray_direction = self.hit = None
+        self.lists = {}
+        self.hit = None
 
 
 def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, max_ray_distance: float
@@ -119,7 +120,7 @@ def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.nda
         return np.zeros(0, np.int64), np.zeros((0, 3))
     grid = build_grid(triangles)
     reach = max_ray_distance / grid.cell if max_ray_distance > 0.0 else 3.0e38
-    cast = GpuRayCast(grid, origins, directions)
+    cast = GpuRayCast(grid, origins, directions)  # its lists in list_inputs.chosen_form()
     try:
         with util.scoped_state():
             for first in range(0, len(origins), RAYS_PER_DISPATCH):
