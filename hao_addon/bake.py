@@ -388,7 +388,7 @@ def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeRe
         w = weight.reshape(weight.shape + (1,) * (total.ndim - weight.ndim))
         return np.divide(total, w, out=np.zeros_like(total), where=w > 0.0)
 
-    ao = _regrown(mean(lambda r: r.ao).astype(np.float32), covered, first, margin)
+    ao = regrown(mean(lambda r: r.ao).astype(np.float32), covered, first, margin)
     bent = None
     if last.bent_normals is not None:
         tiles = mean(lambda r: r.bent_normals)
@@ -404,16 +404,25 @@ def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeRe
     return BakeResult(ao, covered, first.filled, stats, bent, first.tiles, twin, error, first.method)
 
 
-def _regrown(values: np.ndarray, covered: np.ndarray, first: BakeResult, margin: int) -> np.ndarray:
+def regrown(values: np.ndarray, covered: np.ndarray, first: BakeResult, margin: int) -> np.ndarray:
     """values where covered, the margins grown from them as finalize_map grows a map's, the
     first round's background elsewhere; elements (colour attributes) have no margins."""
     if values.ndim == 1:
         return np.where(covered, values, first.ao)
     if values.ndim == 3:  # UDIM tiles
-        return np.stack([_regrown(v, c, replace(first, ao=a, filled=f), margin)
+        return np.stack([regrown(v, c, replace(first, ao=a, filled=f), margin)
                          for v, c, a, f in zip(values, covered, first.ao, first.filled)])
     grown, _valid = dilate(values, covered, margin + 2)
     return np.where(first.filled, grown, first.ao).astype(np.float32)
+
+
+def bake_cells_steps(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings,
+                     cells: np.ndarray) -> Generator[float, None, BakeResult]:
+    """bake_steps of `cells` alone (flat indices into the output, BakePlan.cells), without
+    the cache or a bake to an error: the same directions and seed as a whole bake, so a cell
+    gets the value a whole bake gives it (bakers that bake every cell return all of them)."""
+    run = BakeRun.of(settings).with_cells(np.asarray(cells, np.int64))
+    return _bake_uncached(as_bake_target(target, settings.target), occluders, settings, run)
 
 
 def inverted(soup: TriangleSoup) -> TriangleSoup:

@@ -1,0 +1,165 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Re-bake only what an edit changed, with a stated bound on what is kept.
+
+A bake records its scene (core/bake/scene_changes.SceneState: the settings' key, the target's
+layout, every soup's chunks). The next bake of the same target compares the edited scene's
+state with it: the changed chunks' spheres, before and after, bound how much each receiver's
+AO can have moved (core/bake/change_bound.py, (r / D)^2 for cosine weighting); cells whose
+bound stays below KEEP_SHARE of the map's stated RMSE keep their value, the others are baked
+again (the plan's cells: only the bakers that bake a subset spend less), and the map's margins
+grow again from the merged values. A change of any setting that changes pixels, of the
+target's UVs or faces, a bake to an error and bent normals re-bake in full (said in the report).
+Nothing here touches Blender data.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Generator
+
+import numpy as np
+
+from .bake import BakeResult, bake_cells_steps, bake_steps, regrown
+from .core.bake.abilities import declaration
+from .core.bake.change_bound import cell_bound, change_bound, sampled_change_bound
+from .core.bake.error_estimate import ErrorEstimate, estimate
+from .core.bake.plan import make_plan_steps
+from .core.bake.scene_changes import SceneState, changed_spheres, scene_state
+from .core.bake.settings import BakeSettings
+from .core.geometry import TriangleSoup
+from .core.steps import drain, relay
+
+# Cells whose bound is below this share of the map's stated RMSE are kept: kept cells then add
+# at most half the stated RMSE (in quadrature, the map's RMSE grows by at most 12 %), and the
+# report states the largest bound among them.
+KEEP_SHARE = 0.5
+
+
+@dataclass(frozen=True)
+class RebakeReport:
+    """What a re-bake did: full (and why) or the cells baked again of those covered; the
+    largest bound among kept cells and the threshold they were kept under."""
+
+    full: bool
+    why: str
+    rebaked: int
+    covered: int
+    kept_bound: float = 0.0
+    threshold: float = 0.0
+
+    def text(self) -> str:
+        if self.full:
+            return f"re-baked in full: {self.why}"
+        return (f"re-baked {self.rebaked} of {self.covered} texels ({self.why}); the {self.covered - self.rebaked} "
+                f"kept are within {self.kept_bound:.2g} of the edited scene's AO (kept below {self.threshold:.2g})")
+
+    def as_dict(self) -> dict:
+        return {"full": self.full, "why": self.why, "rebaked": self.rebaked, "covered": self.covered,
+                "kept_bound": self.kept_bound, "threshold": self.threshold}
+
+
+def settings_key(settings: BakeSettings) -> str:
+    """The settings' part of a scene state: every setting that changes pixels (the cache's)."""
+    return repr(settings.cache_key())
+
+
+def record(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings) -> SceneState:
+    """The state a bake of target against occluders records for the next re-bake."""
+    return scene_state(target, occluders, settings_key(settings))
+
+
+def _full_reason(previous: BakeResult | None, before: SceneState | None, after: SceneState,
+                 settings: BakeSettings) -> str:
+    """Why this re-bake cannot keep anything, or ''."""
+    if previous is None or before is None:
+        return "no earlier bake of this target"
+    if before.settings_key != after.settings_key:
+        return "a setting that changes pixels changed"
+    if before.target_layout != after.target_layout:
+        return "the target's UVs or faces changed"
+    if settings.error_target > 0.0:
+        return "a bake to an error is re-baked in full"
+    if settings.bent_normals:
+        return "bent normals have no bound on what an edit changes"
+    if previous.error is None:
+        return "the earlier bake states no error to keep texels under"
+    return ""
+
+
+def rebake_steps(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup,
+                 occluders: list[TriangleSoup], settings: BakeSettings
+                 ) -> Generator[float, None, tuple[BakeResult, SceneState, RebakeReport]]:
+    """The edited scene's bake, from previous (a bake of before's scene with the same settings)
+    where the edit cannot have changed a cell by KEEP_SHARE of its stated RMSE; yields progress.
+    Returns (the map, the state to record for the next re-bake, what was done)."""
+    after = record(target, occluders, settings)
+    reason = _full_reason(previous, before, after, settings)
+    if reason:
+        result = yield from bake_steps(target, occluders, settings, use_cache=False)
+        return result, after, RebakeReport(True, reason, int(result.covered.sum()), int(result.covered.sum()))
+    spheres = changed_spheres(before, after)
+    covered = int(previous.covered.sum())
+    if len(spheres) == 0:
+        yield 1.0
+        return previous, after, RebakeReport(False, "nothing changed", 0, covered)
+    threshold = KEEP_SHARE * previous.error.rmse
+    bounds = yield from relay(_cell_bounds(target, occluders, settings, spheres), lambda f: 0.1 * f)
+    redo = previous.covered.reshape(-1) & (bounds >= threshold)
+    kept = previous.covered.reshape(-1) & ~redo
+    kept_bound = float(bounds[kept].max()) if kept.any() else 0.0
+    why = f"{len(spheres)} changed parts"
+    if not redo.any():
+        yield 1.0
+        return previous, after, RebakeReport(False, why, 0, covered, kept_bound, threshold)
+    cells = np.flatnonzero(redo)
+    part = yield from relay(bake_cells_steps(target, occluders, settings, cells), lambda f: 0.1 + 0.9 * f)
+    merged = _merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound)
+    return merged, after, RebakeReport(False, why, len(cells), covered, kept_bound, threshold)
+
+
+def rebake(previous, before, target, occluders, settings) -> tuple[BakeResult, SceneState, RebakeReport]:
+    """rebake_steps, drained."""
+    return drain(rebake_steps(previous, before, target, occluders, settings))
+
+
+# Changed spheres grow by this many light-view pixels for a GPU baker's bound: it reads
+# visibility from depth maps, where an edit reaches the texels whose rays pass within a pixel
+# (and its filter) of it. The reference traces exact rays: no slack.
+SLACK_PIXELS = 2.0
+
+
+def _cell_bounds(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings, spheres: np.ndarray
+                 ) -> Generator[float, None, np.ndarray]:
+    """(cells,) the largest bound of each output cell's receivers in the edited scene: the
+    larger of what the AO can change by (change_bound) and what the bake's own directions can
+    (sampled_change_bound)."""
+    plan = yield from make_plan_steps(target, occluders, settings)
+    receivers = plan.receivers()
+    world = receivers.points * plan.scale + plan.centre
+    slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
+    grown = spheres + np.array([0.0, 0.0, 0.0, slack])
+    args = (settings.weighting, settings.spread_angle, settings.max_distance)
+    bound = np.maximum(change_bound(world, grown, *args),
+                       sampled_change_bound(world, receivers.shading, grown, plan.directions, *args))
+    return cell_bound(bound, receivers.texel, int(np.prod(plan.layout.output_shape)))
+
+
+def _merged(previous: BakeResult, part: BakeResult, redo: np.ndarray, settings: BakeSettings,
+            kept_bound: float) -> BakeResult:
+    """previous with the re-baked cells' values (and twins) from part, margins grown again;
+    its error the merged twins' with the kept cells' bound added."""
+    fresh = redo & part.covered
+    values = np.where(fresh, part.ao, previous.ao)
+    ao = regrown(values, previous.covered, previous, settings.margin)
+    twin = None
+    error = previous.error
+    if previous.twin is not None and part.twin is not None:
+        twin = np.where(fresh, part.twin, previous.twin).astype(np.float32)
+        noise = estimate(twin, previous.covered, previous.error.directions)
+        error = ErrorEstimate(math.hypot(noise.rmse, kept_bound), noise.p99 + kept_bound, noise.directions,
+                              floor_rmse=previous.error.floor_rmse, floor_p99=previous.error.floor_p99,
+                              floor_texels=previous.error.floor_texels,
+                              floor_unmeasured=previous.error.floor_unmeasured)
+    stats = {**previous.stats, "cache_hit": False, "rebaked_texels": int(redo.sum()),
+             "error": None if error is None else error.as_dict()}
+    return replace(previous, ao=ao, twin=twin, error=error, stats=stats)
