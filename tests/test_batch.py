@@ -48,8 +48,8 @@ def test_batch_names_files_keeps_going_and_reports_each_input(inputs, tmp_path):
     assert done.stdout.count("hao: baked '") == 3
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["status"] == "partial" and report["exit_code"] == 1 and report["error"] == "1 of 4 inputs failed"
-    # Spot's UVs reach past 0..1: each baked input is done with a warning.
-    assert [i["status"] for i in report["inputs"]] == ["warning", "error", "warning", "warning"]
+    # The sample bakes without a warning: each baked input is done, ok.
+    assert [i["status"] for i in report["inputs"]] == ["ok", "error", "ok", "ok"]
     assert report["inputs"][1]["exit_code"] == 2 and report["inputs"][1]["outputs"] == []
     assert report["outputs"] == [str(out / f"{n}_ao.png") for n in "abc"]
     # Per-input overhead: what an input costs beyond its bake phase, after the first (which

@@ -213,9 +213,10 @@ def test_a_colour_bake_replaces_any_attribute_of_its_name(gpu_context, kind, dom
 # -- the smaller cases --------------------------------------------------------------------------
 
 def test_a_cached_bake_names_its_own_object_in_its_warnings(tmp_path):
-    """p.obj and q.obj are the same Spot: q is a cache hit, and its warning names 'q'."""
+    """p.obj and q.obj are the same Spot (as published: its UVs reach past the tile, a warning):
+    q is a cache hit, and its warning names 'q'."""
     for name in ("p", "q"):
-        (tmp_path / f"{name}.obj").write_bytes(SPOT.read_bytes())
+        (tmp_path / f"{name}.obj").write_bytes((ROOT / "tests" / "data" / "spot.obj").read_bytes())
     out = tmp_path / "out"
     out.mkdir()
     done = run(["bake", tmp_path / "p.obj", tmp_path / "q.obj", "--out-dir", out, "--size", "64", "--directions",
