@@ -23,6 +23,11 @@ def inset_barycentrics(bary: np.ndarray) -> np.ndarray:
     return b / b.sum(axis=-1, keepdims=True)
 
 
+# Candidate texels (faces' bounding boxes) tested at once, at most: a block's arrays stay
+# about 200 MB however large the map.
+CANDIDATE_BLOCK = 1 << 22
+
+
 def texel_surface_samples(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For every texel whose centre lies in a UV triangle, that triangle and the barycentric
     coordinates of the centre.
@@ -30,37 +35,55 @@ def texel_surface_samples(uvs: np.ndarray, size: int) -> tuple[np.ndarray, np.nd
     uvs: (F, 3, 2) UV corners in [0, 1]. Returns (face_index (size, size) int64, -1 where
     uncovered; bary (size, size, 3) float64, inset_barycentrics' where covered; hits (size, size) int32: how many triangles
     contain the centre (> 1 where UV islands overlap)). Row y holds v = (y + 0.5) / size.
+    Where triangles overlap, the first (lowest index) holds the texel. Faces are tested in
+    blocks of whole bounding boxes (numpy, no loop per face).
     """
-    face = np.full((size, size), -1, dtype=np.int64)
-    bary = np.zeros((size, size, 3), dtype=np.float64)
-    hits = np.zeros((size, size), dtype=np.int32)
+    face = np.full(size * size, -1, dtype=np.int64)
+    bary = np.zeros((size * size, 3), dtype=np.float64)
+    hits = np.zeros(size * size, dtype=np.int32)
     p = uvs * size - 0.5  # texel-centre coordinates: centre of texel i is at i
     lo = np.clip(np.ceil(p.min(axis=1) - 1e-9), 0, size - 1).astype(np.int64)
     hi = np.clip(np.floor(p.max(axis=1) + 1e-9), 0, size - 1).astype(np.int64)
-    for f in range(len(uvs)):
-        (x0, y0), (x1, y1) = lo[f], hi[f]
-        if x1 < x0 or y1 < y0:
-            continue
-        a, b, c = p[f]
-        det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
-        if abs(det) < 1e-12:
-            continue  # zero-area UV triangle covers no texel centre
-        ys, xs = np.mgrid[y0:y1 + 1, x0:x1 + 1]
-        w1 = ((xs - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (ys - a[1])) / det
-        w2 = ((b[0] - a[0]) * (ys - a[1]) - (xs - a[0]) * (b[1] - a[1])) / det
-        w0 = 1.0 - w1 - w2
-        inside = (w0 >= -1e-9) & (w1 >= -1e-9) & (w2 >= -1e-9)
-        if not inside.any():
-            continue
-        yy, xx = ys[inside], xs[inside]
-        first = face[yy, xx] < 0
-        face[yy[first], xx[first]] = f
-        bary[yy[first], xx[first]] = np.stack([w0[inside], w1[inside], w2[inside]], axis=1)[first]
-        strict = (w0 > 1e-7) & (w1 > 1e-7) & (w2 > 1e-7)
-        hits[ys[strict], xs[strict]] += 1
+    a, b, c = p[:, 0], p[:, 1], p[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    width, height = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
+    # Zero-area UV triangles cover no texel centre; empty boxes (outside the tile) none either.
+    count = np.where((width > 0) & (height > 0) & (np.abs(det) >= 1e-12), width * height, 0)
+    ends = np.cumsum(count)
+    first = 0
+    while first < len(uvs):
+        last = int(np.searchsorted(ends, (ends[first - 1] if first else 0) + CANDIDATE_BLOCK, side="right"))
+        last = max(last, first + 1)
+        _raster_block(np.arange(first, min(last, len(uvs))), count, lo, width, a, b, c, det, size, face, bary, hits)
+        first = last
     covered = face >= 0
     bary[covered] = inset_barycentrics(bary[covered])
-    return face, bary, hits
+    return face.reshape(size, size), bary.reshape(size, size, 3), hits.reshape(size, size)
+
+
+def _raster_block(faces, count, lo, width, a, b, c, det, size, face, bary, hits) -> None:
+    """Test every texel centre of faces' bounding boxes; fill face and bary (flat) where no
+    earlier face holds the texel, count strict hits."""
+    n = count[faces]
+    f = np.repeat(faces, n)
+    if len(f) == 0:
+        return
+    local = np.arange(len(f)) - np.repeat(np.cumsum(n) - n, n)
+    xs = lo[f, 0] + local % width[f]
+    ys = lo[f, 1] + local // width[f]
+    af, bf, cf, d = a[f], b[f], c[f], det[f]
+    w1 = ((xs - af[:, 0]) * (cf[:, 1] - af[:, 1]) - (cf[:, 0] - af[:, 0]) * (ys - af[:, 1])) / d
+    w2 = ((bf[:, 0] - af[:, 0]) * (ys - af[:, 1]) - (xs - af[:, 0]) * (bf[:, 1] - af[:, 1])) / d
+    w0 = 1.0 - w1 - w2
+    texel = ys * size + xs
+    strict = (w0 > 1e-7) & (w1 > 1e-7) & (w2 > 1e-7)
+    np.add.at(hits, texel[strict], 1)
+    inside = np.flatnonzero((w0 >= -1e-9) & (w1 >= -1e-9) & (w2 >= -1e-9))
+    # The first face (candidates are in face order) of each texel no earlier block filled.
+    cells, at = np.unique(texel[inside], return_index=True)
+    take = inside[at][face[cells] < 0]
+    face[texel[take]] = f[take]
+    bary[texel[take]] = np.stack([w0[take], w1[take], w2[take]], axis=1)
 
 
 def interior_mask(face: np.ndarray, hits: np.ndarray, rings: int = 2) -> np.ndarray:
