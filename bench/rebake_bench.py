@@ -51,9 +51,9 @@ def scene(edit_radius: float, moved: bool) -> tuple[TriangleSoup, list[TriangleS
     return floor, balls + [edited]
 
 
-def timed(run):
+def timed(run, *args, **kwargs):
     t0 = time.perf_counter()
-    out = run()
+    out = run(*args, **kwargs)
     return time.perf_counter() - t0, out
 
 
@@ -66,8 +66,8 @@ def size_rows(size: int, directions: int) -> list[dict]:
         base = bake(target, occluders, settings, use_cache=False)
         state = record(target, occluders, settings)
         edited_target, edited = scene(radius, True)
-        incremental_s, (result, _state, report) = timed(lambda: rebake(base, state, edited_target, edited, settings))
-        full_s, full = timed(lambda: bake(edited_target, edited, settings, use_cache=False))
+        incremental_s, (result, _state, report) = timed(rebake, base, state, edited_target, edited, settings)
+        full_s, full = timed(bake, edited_target, edited, settings, use_cache=False)
         diff = np.abs(result.ao.astype(np.float64) - full.ao)[full.covered]
         rows.append({"size": size, "edit": label, "moved_radius": radius, "rebaked_share": report.rebaked / report.covered,
                      "incremental_s": round(incremental_s, 3), "full_s": round(full_s, 3),
