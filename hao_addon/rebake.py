@@ -8,7 +8,8 @@ AO can have moved (core/bake/change_bound.py, (r / D)^2 for cosine weighting); c
 bound stays below KEEP_SHARE of the map's stated RMSE keep their value, the others are baked
 again (the plan's cells: only the bakers that bake a subset spend less), and the map's margins
 grow again from the merged values. A change of any setting that changes pixels, of the
-target's UVs or faces, a bake to an error and bent normals re-bake in full (said in the report).
+target's UVs or faces, a bake to an error, bent normals, colour attributes and UDIM tiles re-bake
+in full (said in the report).
 Nothing here touches Blender data.
 """
 from __future__ import annotations
@@ -21,11 +22,14 @@ import numpy as np
 
 from .bake import BakeResult, bake_cells_steps, bake_steps, regrown
 from .core.bake.abilities import declaration
-from .core.bake.change_bound import cell_bound, change_bound, sampled_change_bound
+from .core.bake.change_bound import cell_bound, change_bound, face_box_bounds, face_pieces, \
+    sampled_change_bound
 from .core.bake.error_estimate import ErrorEstimate, estimate
 from .core.bake.plan import make_plan_steps
-from .core.bake.scene_changes import SceneState, changed_spheres, scene_state
+from .core.bake.scene_changes import SceneState, changed_spheres, face_spheres, scene_state
 from .core.bake.settings import BakeSettings
+from .core.bake.target_kinds import target_kind
+from .core.bake.udim import udim_layout
 from .core.geometry import TriangleSoup
 from .core.steps import drain, relay
 
@@ -69,7 +73,7 @@ def record(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSe
 
 
 def _full_reason(previous: BakeResult | None, before: SceneState | None, after: SceneState,
-                 settings: BakeSettings) -> str:
+                 target: TriangleSoup, settings: BakeSettings) -> str:
     """Why this re-bake cannot keep anything, or ''."""
     if previous is None or before is None:
         return "no earlier bake of this target"
@@ -81,6 +85,10 @@ def _full_reason(previous: BakeResult | None, before: SceneState | None, after: 
         return "a bake to an error is re-baked in full"
     if settings.bent_normals:
         return "bent normals have no bound on what an edit changes"
+    if not target_kind(settings.target).writes_images:
+        return "colour attributes are re-baked in full"
+    if udim_layout(target.uvs) is not None:
+        return "UDIM tiles are re-baked in full"
     if previous.error is None:
         return "the earlier bake states no error to keep texels under"
     return ""
@@ -93,7 +101,7 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
     where the edit cannot have changed a cell by KEEP_SHARE of its stated RMSE; yields progress.
     Returns (the map, the state to record for the next re-bake, what was done)."""
     after = record(target, occluders, settings)
-    reason = _full_reason(previous, before, after, settings)
+    reason = _full_reason(previous, before, after, target, settings)
     if reason:
         result = yield from bake_steps(target, occluders, settings, use_cache=False)
         return result, after, RebakeReport(True, reason, int(result.covered.sum()), int(result.covered.sum()))
@@ -128,20 +136,66 @@ def rebake(previous, before, target, occluders, settings) -> tuple[BakeResult, S
 SLACK_PIXELS = 2.0
 
 
+# The cells' bound is laid out on a grid at most this fine (each fine cell takes its coarse
+# cell's): faces' UV boxes paint it, so its cost does not grow with the map's size.
+BOUND_GRID = 512
+
+
+# Maps up to this size bound each cell by its own receivers (exact, and cheap there); larger
+# ones by pieces of the target's faces (each piece's sphere standing for its receivers),
+# whose cost does not grow with the map.
+RECEIVER_BOUND_SIZE = 512
+
+
 def _cell_bounds(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings, spheres: np.ndarray
                  ) -> Generator[float, None, np.ndarray]:
-    """(cells,) the largest bound of each output cell's receivers in the edited scene: the
-    larger of what the AO can change by (change_bound) and what the bake's own directions can
-    (sampled_change_bound)."""
+    """(cells,) a bound on each output cell's receivers in the edited scene: the larger of what
+    the AO can change by (change_bound) and what the bake's own directions can
+    (sampled_change_bound), at the receivers themselves or, for maps above
+    RECEIVER_BOUND_SIZE, at pieces of the target's faces painted over their UV boxes."""
     plan = yield from make_plan_steps(target, occluders, settings)
-    receivers = plan.receivers()
-    world = receivers.points * plan.scale + plan.centre
     slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
     grown = spheres + np.array([0.0, 0.0, 0.0, slack])
+    if settings.size <= RECEIVER_BOUND_SIZE:
+        return _receiver_bounds(plan, grown, settings)
+    return _piece_bounds(plan, grown, settings)
+
+
+def _receiver_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.ndarray:
+    """(cells,) the largest bound of each cell's receivers."""
+    receivers = plan.receivers()
+    world = receivers.points * plan.scale + plan.centre
     args = (settings.weighting, settings.spread_angle, settings.max_distance)
-    bound = np.maximum(change_bound(world, grown, *args),
-                       sampled_change_bound(world, receivers.shading, grown, plan.directions, *args))
+    bound = np.maximum(change_bound(world, spheres, *args),
+                       sampled_change_bound(world, receivers.shading, spheres, plan.directions, *args))
     return cell_bound(bound, receivers.texel, int(np.prod(plan.layout.output_shape)))
+
+
+def _piece_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.ndarray:
+    """(cells,) each cell's bound from pieces of the target's faces (face_pieces) that reach it."""
+    lit = plan.target_faces[:, 3] > 0.0
+    world = plan.target_positions[lit].astype(np.float64) * plan.scale + plan.centre
+    normals = plan.target_corners[lit, :, :3].astype(np.float64)
+    # Pieces about a quarter of the smallest changed sphere, or half a texel, wide.
+    texel = np.sqrt(_world_per_uv(world, plan.target_uvs[lit])) / settings.size
+    world, uvs, normals = face_pieces(world, plan.target_uvs[lit].astype(np.float64), normals,
+                                      radius=max(0.25 * float(spheres[:, 3].min()), 0.5 * texel))
+    normals /= np.maximum(np.linalg.norm(normals, axis=2, keepdims=True), 1e-30)
+    faces = face_spheres(world)
+    args = (settings.weighting, settings.spread_angle, settings.max_distance)
+    bound = np.maximum(change_bound(faces[:, :3], spheres, *args, reach=faces[:, 3]),
+                       sampled_change_bound(faces[:, :3], normals, spheres, plan.directions, *args,
+                                            reach=faces[:, 3]))
+    return face_box_bounds(uvs, bound, settings.size, BOUND_GRID).reshape(-1)
+
+
+def _world_per_uv(world: np.ndarray, uvs: np.ndarray) -> float:
+    """World area per unit of UV area over the target (its texels' world size squared, times
+    size^2)."""
+    world_area = 0.5 * np.linalg.norm(np.cross(world[:, 1] - world[:, 0], world[:, 2] - world[:, 0]), axis=1).sum()
+    e1, e2 = uvs[:, 1] - uvs[:, 0], uvs[:, 2] - uvs[:, 0]
+    uv_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
+    return float(world_area / max(uv_area, 1e-300))
 
 
 def _merged(previous: BakeResult, part: BakeResult, redo: np.ndarray, settings: BakeSettings,

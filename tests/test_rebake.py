@@ -153,3 +153,16 @@ def test_changed_spheres_hold_what_changed_and_nothing_else():
     spheres = sc.changed_spheres(base, sc.scene_state(plane(), [clear, BASE["b"], BASE["c"]], key))
     assert holds(spheres, BASE["a"].positions.reshape(-1, 3))
     assert len(sc.changed_spheres(base, sc.scene_state(plane(), list(BASE.values()), key))) == 0
+
+
+def test_large_maps_bound_by_face_pieces_and_hold_it(base_bake, monkeypatch):
+    """Maps above RECEIVER_BOUND_SIZE bound cells by pieces of the target's faces painted over
+    their UV boxes (no receiver list): forced here on the small map, a coarser bound that
+    still holds on every kind of edit."""
+    from hao_addon import rebake as rebake_module
+    monkeypatch.setattr(rebake_module, "RECEIVER_BOUND_SIZE", 0)
+    previous, state = base_bake
+    for _label, occluders, bumps, settings in edits()[::5]:
+        target = plane(bumps)
+        result, _state, report = rebake(previous, state, target, list(occluders.values()), settings)
+        check(result, report, bake(target, list(occluders.values()), settings, use_cache=False))

@@ -44,20 +44,25 @@ def cone_share(sin_t: np.ndarray, weighting: str, spread_angle: float = 90.0) ->
 
 
 def change_bound(points: np.ndarray, spheres: np.ndarray, weighting: str = "cosine",
-                 spread_angle: float = 90.0, max_distance: float = 0.0) -> np.ndarray:
+                 spread_angle: float = 90.0, max_distance: float = 0.0, reach: np.ndarray | None = None
+                 ) -> np.ndarray:
     """(n,) float64 in [0, 1]: the most each receiver's AO can change when what lies inside
     spheres changes. points: (n, 3) receivers, world; spheres: (k, 4) centre and radius,
     world (the changed geometry before and after the edit); max_distance: the bake's (0 =
-    unlimited)."""
+    unlimited); reach: (n,) each point stands for receivers up to this far from it (a face's
+    bounding sphere): its spheres grow by it (a ray from a receiver r away that enters a
+    sphere passes within radius + r of the point)."""
     points = np.asarray(points, np.float64).reshape(-1, 3)
+    reach = np.zeros(len(points)) if reach is None else np.asarray(reach, np.float64)
     spheres = np.asarray(spheres, np.float64).reshape(-1, 4)
     bound = np.zeros(len(points))
     if len(spheres) == 0:
         return bound
-    centres, radii = spheres[:, :3], spheres[:, 3]
+    centres = spheres[:, :3]
     for start in range(0, len(points), max(1, BLOCK // len(spheres))):
         block = points[start:start + max(1, BLOCK // len(spheres))]
         distance = np.linalg.norm(block[:, None, :] - centres[None], axis=2)  # (b, k)
+        radii = spheres[None, :, 3] + reach[start:start + len(block), None]
         sin_t = np.where(distance > radii, radii / np.maximum(distance, 1e-300), 1.0)
         share = cone_share(sin_t, weighting, spread_angle)
         if max_distance > 0.0:
@@ -67,16 +72,20 @@ def change_bound(points: np.ndarray, spheres: np.ndarray, weighting: str = "cosi
 
 
 def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.ndarray, directions: np.ndarray,
-                         weighting: str = "cosine", spread_angle: float = 90.0, max_distance: float = 0.0
-                         ) -> np.ndarray:
+                         weighting: str = "cosine", spread_angle: float = 90.0, max_distance: float = 0.0,
+                         reach: np.ndarray | None = None) -> np.ndarray:
     """(n,) float64: the most a bake's own estimate (sum of V w over its directions / sum of w)
     can change at each receiver: the weight share of its directions (D, 3) that point into a
     changed sphere. The estimate of finitely many directions is not bounded by change_bound's
     share of the whole hemisphere (a direction that falls into a small cone moves it by about
-    1 / D); kept texels are held to both. normals: (n, 3) the receivers' shading normals."""
+    1 / D); kept texels are held to both. normals: (n, 3) the receivers' shading normals, or
+    (n, m, 3) several each (a face's corners: each direction weighs its most over them, the
+    total its least); reach: as change_bound's."""
     from .normalization import hemisphere_weight
 
     points = np.asarray(points, np.float64).reshape(-1, 3)
+    normals = np.asarray(normals, np.float64).reshape(len(points), -1, 3)
+    reach = np.zeros(len(points)) if reach is None else np.asarray(reach, np.float64)
     spheres = np.asarray(spheres, np.float64).reshape(-1, 4)
     directions = np.asarray(directions, np.float64).reshape(-1, 3)
     spread_cos = 0.0 if spread_angle >= 90.0 else float(np.cos(np.radians(spread_angle)))
@@ -84,10 +93,12 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
     rows = max(1, BLOCK * 4 // max(len(directions), 1))
     for start in range(0, len(points), rows):
         p, n = points[start:start + rows], normals[start:start + rows]
-        weight = hemisphere_weight(n @ directions.T, weighting, spread_cos)  # (b, D)
-        total = np.maximum(weight.sum(axis=1), 1e-300)
+        weights = hemisphere_weight(n @ directions.T, weighting, spread_cos)  # (b, m, D)
+        weight = weights.max(axis=1)
+        total = np.maximum(weights.sum(axis=2).min(axis=1), 1e-300)
         inside = np.zeros(weight.shape, bool)
-        for centre, radius in zip(spheres[:, :3], spheres[:, 3]):
+        for centre, sphere_radius in zip(spheres[:, :3], spheres[:, 3]):
+            radius = sphere_radius + reach[start:start + len(p)]
             to = centre - p
             dist = np.linalg.norm(to, axis=1)
             near = dist > radius
@@ -108,3 +119,59 @@ def cell_bound(bound: np.ndarray, cells: np.ndarray, cell_count: int) -> np.ndar
     out = np.zeros(cell_count)
     np.maximum.at(out, np.asarray(cells, np.int64), bound)
     return out
+
+
+def face_box_bounds(uvs: np.ndarray, bound: np.ndarray, size: int, grid: int) -> np.ndarray:
+    """(size, size) each texel's bound: the largest of the faces (uvs (F, 3, 2), bound (F,))
+    whose UV box, grown by a texel, reaches the cell of a grid x grid raster holding it (every
+    face that can put a sample point into a texel reaches its cell: a bound for all of them)."""
+    grid = min(grid, size)
+    lo = np.clip(np.floor((uvs.min(axis=1) - 1.0 / size) * grid), 0, grid - 1).astype(np.int64)
+    hi = np.clip(np.floor((uvs.max(axis=1) + 1.0 / size) * grid), 0, grid - 1).astype(np.int64)
+    width, height = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
+    count = width * height
+    face = np.repeat(np.arange(len(uvs)), count)
+    local = np.arange(len(face)) - np.repeat(np.cumsum(count) - count, count)
+    cell = (lo[face, 1] + local // width[face]) * grid + lo[face, 0] + local % width[face]
+    coarse = np.zeros(grid * grid)
+    np.maximum.at(coarse, cell, bound[face])
+    rows = np.arange(size) * grid // size
+    return coarse.reshape(grid, grid)[rows[:, None], rows[None, :]]
+
+
+# Pieces a bound is computed over, at most (face_pieces): a few hundred MB of arrays.
+MAX_PIECES = 1 << 21
+
+
+def _subdivision(level: int) -> np.ndarray:
+    """(level^2, 3, 3) barycentric corners of a triangle cut into level^2 like triangles."""
+    out = []
+    for i in range(level):
+        for j in range(level - i):
+            a, b, c = (i, j), (i + 1, j), (i, j + 1)
+            out.append([a, b, c])
+            if i + j < level - 1:
+                out.append([(i + 1, j), (i + 1, j + 1), (i, j + 1)])
+    ij = np.asarray(out, np.float64) / level  # (level^2, 3, 2): (u, v) weights of corners 1, 2
+    return np.concatenate([1.0 - ij.sum(axis=2, keepdims=True), ij], axis=2)
+
+
+def face_pieces(*per_corner: np.ndarray, radius: float) -> list[np.ndarray]:
+    """The faces of per_corner arrays (each (F, 3, ...): world corners first, then UVs,
+    normals) cut into pieces no wider than about radius (each face into level^2 triangles,
+    level up to 32 and MAX_PIECES in all): a large face of a low-poly target would otherwise
+    stand for all its receivers with one wide sphere."""
+    world = per_corner[0]
+    centre = 0.5 * (world.min(axis=1) + world.max(axis=1))
+    reach = np.linalg.norm(world - centre[:, None], axis=2).max(axis=1)
+    level = np.clip(np.ceil(reach / max(radius, 1e-300)), 1, 32).astype(np.int64)
+    while (level ** 2).sum() > MAX_PIECES and level.max() > 1:
+        level = np.maximum(1, level // 2)
+    parts: list[list[np.ndarray]] = [[] for _ in per_corner]
+    for lv in np.unique(level):
+        faces = np.flatnonzero(level == lv)
+        bary = _subdivision(int(lv))  # (P, 3, 3)
+        for k, array in enumerate(per_corner):
+            pieces = np.einsum("pck,fk...->fpc...", bary, array[faces])
+            parts[k].append(pieces.reshape(-1, *array.shape[1:]))
+    return [np.concatenate(p) for p in parts]

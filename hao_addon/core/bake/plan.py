@@ -22,7 +22,7 @@ from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
 from ..steps import drain
 from .projection import HighToLow, RayCast, check_high_to_low
-from .receivers import Receivers
+from .receivers import Receivers, faces_touching
 from .bake_run import BakeRun
 from .settings import BakeSettings
 from .target_layouts import LAYOUTS, TexelLayout
@@ -217,6 +217,18 @@ class BakePlan:
         return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side)
 
 
+def _view_corners(t_pos: np.ndarray, target_weld, target, settings: BakeSettings, run: BakeRun,
+                  layout: TexelLayout) -> np.ndarray:
+    """(n, 3) normalized target corners a light view's window is fitted to: the distinct ones,
+    or, for a run of some texels of one UV tile (an incremental re-bake's cells), the corners of
+    the faces that reach them: each view then covers only their part of the scene (a ray from a
+    receiver stays inside its window), and costs that part's pixels."""
+    if run.cells is None or layout.KIND != "texel" or layout.udim is not None or target.uvs is None:
+        return t_pos.reshape(-1, 3)[target_weld[0]]
+    faces = faces_touching(target.uvs, settings.size, run.cells)
+    return t_pos[faces].reshape(-1, 3) if len(faces) else t_pos.reshape(-1, 3)[target_weld[0]]
+
+
 # The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets
 # that cover the unit square evenly in any run of views, at no cost (seeding a numpy
 # generator per view took 0.27 ms, 3 % of a light view).
@@ -296,15 +308,20 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
                         holes, smooth_corners, uv_warnings + layout.warnings, alpha, {**uv_counters, **layout.counters})
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
+    view_corners = _view_corners(t_pos, target_weld, target, settings, run, layout)
+    # A view's side is at most the diameter of what it is fitted to: the whole target's (extent
+    # about the origin), or the part a run of some cells fits its views to.
+    reach = min(extent, float(np.linalg.norm(view_corners - 0.5 * (view_corners.min(0) + view_corners.max(0)),
+                                             axis=1).max()))
     return BakePlan(
         settings=settings, run=run, layout=layout, method=method, centre=centre, scale=scale,
         target_positions=t_pos.astype(np.float32), target_uvs=uvs.astype(np.float32),
         target_faces=np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), target_corners=corners,
         target_above=above, occluder_positions=o_pos.astype(np.float32),
         occluder_normals=np.asarray(o_normals, dtype=np.float32), directions=directions, pixel_size=pixel_size,
-        max_view_side=int(np.ceil(2.0 * extent / pixel_size)) + 4,
+        max_view_side=int(np.ceil(2.0 * reach / pixel_size)) + 4,
         # Distinct corners: a light view's window is fitted to them (shared corners once).
-        target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
+        target_points=layout.view_points(view_corners, pixel_size),
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
         smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
         stats=stats, alpha=alpha)

@@ -93,13 +93,33 @@ def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) ->
     return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
 
 
+def faces_touching(uvs: np.ndarray, size: int, cells: np.ndarray) -> np.ndarray:
+    """(k,) int64 the faces whose UV box (grown by a texel) holds one of cells (flat y * size +
+    x of one 0..1 tile): every face that can put a sample point into them, in face order."""
+    mark = np.zeros((size + 1, size + 1), np.int64)  # a summed-area table of the cells
+    mark[1:, 1:] = np.bincount(np.asarray(cells, np.int64), minlength=size * size).reshape(size, size)
+    table = mark.cumsum(0).cumsum(1)
+    p = uvs * size
+    lo = np.clip(np.floor(p.min(axis=1)) - 1, 0, size).astype(np.int64)
+    hi = np.clip(np.ceil(p.max(axis=1)) + 1, 0, size).astype(np.int64)
+    inside = table[hi[:, 1], hi[:, 0]] - table[lo[:, 1], hi[:, 0]] - table[hi[:, 1], lo[:, 0]] + table[lo[:, 1], lo[:, 0]]
+    return np.flatnonzero(inside > 0)
+
+
 def uv_receivers(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray, corners: np.ndarray, size: int,
-                 samples_per_texel: int = 1, lift: bool = False, tiles: UdimLayout | None = None) -> Receivers:
+                 samples_per_texel: int = 1, lift: bool = False, tiles: UdimLayout | None = None,
+                 cells: np.ndarray | None = None) -> Receivers:
     """The target's own surface at the sample points of its UV layout (BakePlan fields:
     positions (F, 3, 3) normalized, uvs (F, 3, 2), faces (F, 4) normal and 1 / S_f, corners
     (F, 3, 4) shading normal and 1 / S). Faces never lit are left out. 1 / S is interpolated
     like the GPU passes interpolate it. lift: with Cycles' terminator lift of each point.
-    tiles: the UDIM tiles of a tiled layout (texel tile * size^2 + y * size + x)."""
+    tiles: the UDIM tiles of a tiled layout (texel tile * size^2 + y * size + x). cells: only
+    these texels' points (of one 0..1 tile), rasterizing only the faces that reach them."""
+    if cells is not None and tiles is None:
+        subset = faces_touching(uvs, size, cells)
+        texel, face, bary = texel_sample_points(uvs[subset], size, samples_per_texel)
+        keep = np.isin(texel, cells)
+        return receivers_at(positions, faces, corners, texel[keep], subset[face[keep]], bary[keep], lift)
     texel, face, bary = tiled_sample_points(uvs, size, samples_per_texel, tiles)
     return receivers_at(positions, faces, corners, texel, face, bary, lift)
 

@@ -107,9 +107,10 @@ class TexelLayout:
         return None
 
     def receivers(self, plan) -> Receivers:
-        """The receivers of `plan` (a BakePlan of this layout)."""
+        """The receivers of `plan` (a BakePlan of this layout); of its cells alone where it
+        names them (only the faces reaching them rasterized)."""
         return uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
-                            self.size, self.sample_count, plan.lifts_terminator, self.udim)
+                            self.size, self.sample_count, plan.lifts_terminator, self.udim, plan.cells)
 
     def receiver_bound(self) -> int:
         """The most receivers a whole bake has (a reference bake's rays per direction)."""
