@@ -15,7 +15,7 @@ Nothing here touches Blender data.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Generator
 
 import numpy as np
@@ -50,6 +50,8 @@ class RebakeReport:
     covered: int
     kept_bound: float = 0.0
     threshold: float = 0.0
+    # The cells baked again (flat indices into the map), None for a full bake or none.
+    cells: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     def text(self) -> str:
         if self.full:
@@ -122,7 +124,7 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
     cells = np.flatnonzero(redo)
     part = yield from relay(bake_cells_steps(target, occluders, settings, cells), lambda f: 0.1 + 0.9 * f)
     merged = _merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound)
-    return merged, after, RebakeReport(False, why, len(cells), covered, kept_bound, threshold)
+    return merged, after, RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells)
 
 
 def rebake(previous, before, target, occluders, settings) -> tuple[BakeResult, SceneState, RebakeReport]:
