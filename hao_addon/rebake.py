@@ -120,7 +120,8 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
     why = f"{len(spheres)} changed parts"
     if not redo.any():
         yield 1.0
-        return previous, after, RebakeReport(False, why, 0, covered, kept_bound, threshold)
+        kept = replace(previous, error=_with_bound(previous.error, previous.error, kept_bound))
+        return kept, after, RebakeReport(False, why, 0, covered, kept_bound, threshold)
     cells = np.flatnonzero(redo)
     part = yield from relay(bake_cells_steps(target, occluders, settings, cells), lambda f: 0.1 + 0.9 * f)
     merged = _merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound)
@@ -200,6 +201,14 @@ def _world_per_uv(world: np.ndarray, uvs: np.ndarray) -> float:
     return float(world_area / max(uv_area, 1e-300))
 
 
+def _with_bound(noise: ErrorEstimate, previous: ErrorEstimate, kept_bound: float) -> ErrorEstimate:
+    """noise's estimate with the kept cells' bound added (RMSE in quadrature, p99 plainly) and
+    previous's visibility floor."""
+    return ErrorEstimate(math.hypot(noise.rmse, kept_bound), noise.p99 + kept_bound, noise.directions,
+                         floor_rmse=previous.floor_rmse, floor_p99=previous.floor_p99,
+                         floor_texels=previous.floor_texels, floor_unmeasured=previous.floor_unmeasured)
+
+
 def _merged(previous: BakeResult, part: BakeResult, redo: np.ndarray, settings: BakeSettings,
             kept_bound: float) -> BakeResult:
     """previous with the re-baked cells' values (and twins) from part, margins grown again;
@@ -211,11 +220,7 @@ def _merged(previous: BakeResult, part: BakeResult, redo: np.ndarray, settings: 
     error = previous.error
     if previous.twin is not None and part.twin is not None:
         twin = np.where(fresh, part.twin, previous.twin).astype(np.float32)
-        noise = estimate(twin, previous.covered, previous.error.directions)
-        error = ErrorEstimate(math.hypot(noise.rmse, kept_bound), noise.p99 + kept_bound, noise.directions,
-                              floor_rmse=previous.error.floor_rmse, floor_p99=previous.error.floor_p99,
-                              floor_texels=previous.error.floor_texels,
-                              floor_unmeasured=previous.error.floor_unmeasured)
+        error = _with_bound(estimate(twin, previous.covered, previous.error.directions), previous.error, kept_bound)
     stats = {**previous.stats, "cache_hit": False, "rebaked_texels": int(redo.sum()),
              "error": None if error is None else error.as_dict()}
     return replace(previous, ao=ao, twin=twin, error=error, stats=stats)
