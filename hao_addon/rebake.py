@@ -128,7 +128,8 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
     return merged, after, RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells)
 
 
-def rebake(previous, before, target, occluders, settings) -> tuple[BakeResult, SceneState, RebakeReport]:
+def rebake(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup, occluders: list[TriangleSoup],
+           settings: BakeSettings) -> tuple[BakeResult, SceneState, RebakeReport]:
     """rebake_steps, drained."""
     return drain(rebake_steps(previous, before, target, occluders, settings))
 

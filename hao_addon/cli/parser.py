@@ -9,7 +9,7 @@ import sys
 
 from .. import __version__
 from .errors import CLIError
-from .io import ProcessOutput
+from .io import ProcessOutput, Progress
 from .options import add_setting_options
 from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 
@@ -41,8 +41,9 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--chunk", type=int, default=None, help="with --manifest: the chunk to bake (0 is the first)")
     b.add_argument("--input-root", default=None, metavar="DIR", help="with --manifest: the folder of its inputs")
     b.add_argument("--progress", choices=("terminal", "openjd"), default="terminal",
-                   help="terminal: a progress line on a terminal, or, with stderr redirected to a log, a line every 10 s once "
-                        "a run has lasted 10 s; openjd: 'openjd_progress: P' lines on stdout "
+                   help=f"terminal: a progress line on a terminal, or, with stderr redirected to a log, a line every "
+                        f"{Progress.LOG_INTERVAL:g} s once a run has lasted {Progress.LOG_INTERVAL:g} s; openjd: "
+                        "'openjd_progress: P' lines on stdout "
                         "(Open Job Description's form, for farm tasks)")
     add_run_options(b)
 

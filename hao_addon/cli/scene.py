@@ -201,9 +201,10 @@ def pick_target(name: str, exclude: tuple = (), from_blend: bool = False) -> tup
         return obj, ""
     meshes = [o for o in bpy.context.view_layer.objects
               if o.type == 'MESH' and o not in exclude and o.visible_get()]
-    if not meshes and _mesh_names() != "none":
-        raise CLIError(f"the input's meshes are all hidden ({_mesh_names()}): name one with --object NAME")
     if not meshes:
+        every = _mesh_names()
+        if every != "none":
+            raise CLIError(f"the input's meshes are all hidden ({every}): name one with --object NAME")
         raise CLIError("the input contains no mesh object")
     if len(meshes) == 1:
         return meshes[0], ""

@@ -47,7 +47,7 @@ def _ray_cast_info(form_name: str) -> "gpu.types.GPUShaderCreateInfo":
     info.push_constant('FLOAT', "reach")
     for slot, (name, kind) in enumerate(LIST_INPUTS):
         form.declare(info, slot, name, kind)
-    form.declare(info, len(LIST_INPUTS) if form_name == "storage" else 0, "hit_out", "VEC4", write=True)
+    form.declare(info, form.output_slot(len(LIST_INPUTS)), "hit_out", "VEC4", write=True)
     info.compute_source(form.prelude() + glsl_source("bake_ray_cast.comp"))
     return info
 

@@ -40,6 +40,10 @@ class TextureLists:
         else:
             info.sampler(slot, 'FLOAT_2D', name)
 
+    def output_slot(self, inputs: int) -> int:
+        """The slot of the first written list after `inputs` read ones: images number apart."""
+        return 0
+
     def prelude(self) -> str:
         return ("#define LIST_AT(i) ivec2((i) % LIST_WIDTH, (i) / LIST_WIDTH)\n"
                 "#define LIST_VEC4(list, i) texelFetch(list, LIST_AT(i), 0)\n"
@@ -76,6 +80,10 @@ class StorageLists:
 
     def declare(self, info, slot: int, name: str, kind: str, write: bool = False) -> None:
         compat.declare_storage_list(info, slot, KINDS[kind], name, write)
+
+    def output_slot(self, inputs: int) -> int:
+        """The slot of the first written list after `inputs` read ones: one numbering for all."""
+        return inputs
 
     def prelude(self) -> str:
         return ("#define LIST_VEC4(list, i) list[i]\n"

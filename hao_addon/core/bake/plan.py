@@ -311,8 +311,8 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     view_corners = _view_corners(t_pos, target_weld, target, settings, run, layout)
     # A view's side is at most the diameter of what it is fitted to: the whole target's (extent
     # about the origin), or the part a run of some cells fits its views to.
-    reach = min(extent, float(np.linalg.norm(view_corners - 0.5 * (view_corners.min(0) + view_corners.max(0)),
-                                             axis=1).max()))
+    reach = extent if run.cells is None else min(extent, float(np.linalg.norm(
+        view_corners - 0.5 * (view_corners.min(0) + view_corners.max(0)), axis=1).max()))
     return BakePlan(
         settings=settings, run=run, layout=layout, method=method, centre=centre, scale=scale,
         target_positions=t_pos.astype(np.float32), target_uvs=uvs.astype(np.float32),
