@@ -49,8 +49,9 @@ vec3 plane_lookup(int k, vec3 position, vec3 plane_normal, float slope_slack)
   vec2 at, slope;
   float depth;
   receiver_plane(k, position, plane_normal, at, depth, slope);
+  /* Of a cropped view, its depth map holds the pixels of the window alone (views.window). */
   vec2 px = floor(at);
-  if (any(lessThan(px, vec2(0.0))) || any(greaterThanEqual(px, views.view_info[k].xy))) {
+  if (any(lessThan(px, views.window[k].xy)) || any(greaterThanEqual(px, views.window[k].xy + views.window[k].zw))) {
     return vec3(-1.0);
   }
   return vec3(px, occluding_depth(k, px, at, depth, slope, slope_slack));
@@ -86,7 +87,8 @@ float visible_from(sampler2D depth_tex, int k, vec3 position, vec3 plane_normal,
   vec2 toward = sign(at - (lookup.xy + 0.5));
   float seen = (lookup.z <= stored || stored >= 1.0) ? 1.0 : 0.0;
   for (int t = 1; t < 4; t++) {
-    vec2 px = clamp(lookup.xy + vec2(float(t & 1), float(t >> 1)) * toward, vec2(0.0), views.view_info[k].xy - 1.0);
+    vec2 px = clamp(lookup.xy + vec2(float(t & 1), float(t >> 1)) * toward, views.window[k].xy,
+                    views.window[k].xy + views.window[k].zw - 1.0);
     float tap = texelFetch(depth_tex, ivec2(px), 0).r;
     seen += (occluding_depth(k, px, at, depth, slope, slope_slack) <= tap || tap >= 1.0) ? 1.0 : 0.0;
   }

@@ -22,11 +22,11 @@ import numpy as np
 
 from .bake import BakeResult, bake_cells_steps, bake_steps, regrown
 from .core.bake.abilities import declaration
-from .core.bake.change_bound import cell_bound, change_bound, face_box_bounds, face_pieces, \
+from .core.bake.change_bound import cell_bound, change_bound, face_box_bounds, refined_piece_bounds, \
     sampled_change_bound
 from .core.bake.error_estimate import ErrorEstimate, estimate
 from .core.bake.plan import make_plan_steps
-from .core.bake.scene_changes import SceneState, changed_spheres, face_spheres, scene_state
+from .core.bake.scene_changes import SceneState, changed_spheres, scene_state
 from .core.bake.settings import BakeSettings
 from .core.bake.target_kinds import target_kind
 from .core.bake.udim import udim_layout
@@ -113,7 +113,7 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
         yield 1.0
         return previous, after, RebakeReport(False, "nothing changed", 0, covered)
     threshold = KEEP_SHARE * previous.error.rmse
-    bounds = yield from relay(_cell_bounds(target, occluders, settings, spheres), lambda f: 0.1 * f)
+    bounds = yield from relay(_cell_bounds(target, occluders, settings, spheres, threshold), lambda f: 0.1 * f)
     redo = previous.covered.reshape(-1) & (bounds >= threshold)
     kept = previous.covered.reshape(-1) & ~redo
     kept_bound = float(bounds[kept].max()) if kept.any() else 0.0
@@ -149,20 +149,22 @@ BOUND_GRID = 512
 # ones by pieces of the target's faces (each piece's sphere standing for its receivers),
 # whose cost does not grow with the map.
 RECEIVER_BOUND_SIZE = 512
+PIECE_SHARE = 0.25
 
 
-def _cell_bounds(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings, spheres: np.ndarray
-                 ) -> Generator[float, None, np.ndarray]:
+def _cell_bounds(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings, spheres: np.ndarray,
+                 threshold: float) -> Generator[float, None, np.ndarray]:
     """(cells,) a bound on each output cell's receivers in the edited scene: the larger of what
     the AO can change by (change_bound) and what the bake's own directions can
     (sampled_change_bound), at the receivers themselves or, for maps above
-    RECEIVER_BOUND_SIZE, at pieces of the target's faces painted over their UV boxes."""
+    RECEIVER_BOUND_SIZE, at pieces of the target's faces painted over their UV boxes (cut
+    finer where they reach threshold)."""
     plan = yield from make_plan_steps(target, occluders, settings)
     slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
     grown = spheres + np.array([0.0, 0.0, 0.0, slack])
     if settings.size <= RECEIVER_BOUND_SIZE:
         return _receiver_bounds(plan, grown, settings)
-    return _piece_bounds(plan, grown, settings)
+    return _piece_bounds(plan, grown, settings, threshold)
 
 
 def _receiver_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.ndarray:
@@ -175,21 +177,24 @@ def _receiver_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.nd
     return cell_bound(bound, receivers.texel, int(np.prod(plan.layout.output_shape)))
 
 
-def _piece_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.ndarray:
-    """(cells,) each cell's bound from pieces of the target's faces (face_pieces) that reach it."""
+def _piece_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: float) -> np.ndarray:
+    """(cells,) each cell's bound from pieces of the target's faces that reach it, cut finer
+    where the bound reaches threshold (change_bound.refined_piece_bounds)."""
     lit = plan.target_faces[:, 3] > 0.0
     world = plan.target_positions[lit].astype(np.float64) * plan.scale + plan.centre
     normals = plan.target_corners[lit, :, :3].astype(np.float64)
-    # Pieces about a quarter of the smallest changed sphere, or half a texel, wide.
+    # Pieces down to about a quarter of the smallest changed sphere, or half a texel, wide.
     texel = np.sqrt(_world_per_uv(world, plan.target_uvs[lit])) / settings.size
-    world, uvs, normals = face_pieces(world, plan.target_uvs[lit].astype(np.float64), normals,
-                                      radius=max(0.25 * float(spheres[:, 3].min()), 0.5 * texel))
-    normals /= np.maximum(np.linalg.norm(normals, axis=2, keepdims=True), 1e-30)
-    faces = face_spheres(world)
     args = (settings.weighting, settings.spread_angle, settings.max_distance)
-    bound = np.maximum(change_bound(faces[:, :3], spheres, *args, reach=faces[:, 3]),
-                       sampled_change_bound(faces[:, :3], normals, spheres, plan.directions, *args,
-                                            reach=faces[:, 3]))
+
+    def bound_of(pieces: np.ndarray, corner_normals: np.ndarray) -> np.ndarray:
+        unit = corner_normals / np.maximum(np.linalg.norm(corner_normals, axis=2, keepdims=True), 1e-30)
+        return np.maximum(change_bound(pieces[:, :3], spheres, *args, reach=pieces[:, 3]),
+                          sampled_change_bound(pieces[:, :3], unit, spheres, plan.directions, *args,
+                                               reach=pieces[:, 3]))
+
+    uvs, bound = refined_piece_bounds(world, plan.target_uvs[lit].astype(np.float64), normals, bound_of, threshold,
+                                      max(PIECE_SHARE * float(spheres[:, 3].min()), 0.5 * texel))
     return face_box_bounds(uvs, bound, settings.size, BOUND_GRID).reshape(-1)
 
 

@@ -280,6 +280,14 @@ def test_rounds_can_leave_converged_texels_out(gpu_context, monkeypatch, method)
         return receivers
 
     monkeypatch.setattr(plan_module.BakePlan, "receivers", counted)
+    from hao_addon.gpu import gather_texel_list  # the gather keeps its raster's entries in the cells
+    keep_cells = gather_texel_list.TexelList._keep_cells_entries
+
+    def kept(baker, cells):
+        keep_cells(baker, cells)
+        listed.append((True, baker.entry_count))
+
+    monkeypatch.setattr(gather_texel_list.TexelList, "_keep_cells_entries", kept)
     floor, ball = scenes.grid_plane(4.0, 8, name="floor"), scenes.uv_sphere(0.6, (0, 0, 0.6), 24, 12, name="ball")
     res = bake(floor, [ball], BakeSettings(size=24, directions=4096, method=method, margin=0, max_error=0.03),
                use_cache=False)

@@ -108,11 +108,11 @@ def test_constants_reach_glsl_from_python_only():
         # The value itself only where it is distinctive (1.0 is written everywhere).
         distinctive = len(repr(value)) > 4
         assert not any(f"#define {name}" in s or (distinctive and repr(value) in s) for s in sources.values()), name
-    # std140 size of GatherViews: one array of GATHER_MAX_VIEWS mat4 (64 B) and three of vec4 (16 B).
+    # std140 size of GatherViews: one array of GATHER_MAX_VIEWS mat4 (64 B) and four of vec4 (16 B).
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
-    assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16 + 16)
-    assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "plane_slope", "omega", "view_info")] == \
-        [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80, GATHER_MAX_VIEWS * 96]
+    assert GATHER_VIEWS_DTYPE.itemsize == GATHER_MAX_VIEWS * (64 + 16 + 16 + 16 + 16)
+    assert [GATHER_VIEWS_DTYPE.fields[f][1] for f in ("view_proj", "plane_slope", "omega", "view_info", "window")] \
+        == [0, GATHER_MAX_VIEWS * 64, GATHER_MAX_VIEWS * 80, GATHER_MAX_VIEWS * 96, GATHER_MAX_VIEWS * 112]
 
 
 def test_shader_comments_cite_files_that_exist():

@@ -30,25 +30,17 @@ import numpy as np
 
 from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
 from ..core.bake.normal_bins import (BIN_COUNT, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
-                                     normal_bins, octahedral_coords, octahedral_decode, proximity_order)
-from ..core.errors import BakeInputError
+                                     normal_bins, octahedral_decode, proximity_order)
 from ..core.directions import probe_order
 from ..core.bake.estimators import texel_sums
 from ..core.bake.plan import BakePlan
 from ..core.bake.probe_snapshot import EntrySnapshot
 from ..core.bake.receivers import Receivers
 from . import util
+from .gather_texel_list import TexelList, entry_bytes, faces_reaching_cells
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .gather_shaders import (ACCUM_FORMATS, ACCUM_NAMES, FORMAT_CHANNELS, GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE,
-                             GROUP_SIZE, LIST_WIDTH, gather_shader, texel_list_shader)
-
-ENTRY_BYTES = 16 + 16 + 4  # position + 1/S_f, normal, texel (and 4 bytes per estimator channel)
-LIFT_BYTES = 16  # an entry's terminator lift, where the plan lifts (plan.lifts_terminator)
-
-
-def entry_bytes(plan: BakePlan) -> int:
-    return ENTRY_BYTES + 4 * plan.estimator.channel_count + (LIFT_BYTES if plan.lifts_terminator else 0)
-
+                             GROUP_SIZE, LIST_WIDTH, gather_shader)
 
 # Directions tested per compute dispatch: an entry and its sums are loaded once for all of
 # them. On the smooth bunny (llvmpipe) an entry's loads, decodes and store cost about twice
@@ -72,8 +64,10 @@ GPU_TEXEL_LIST = True
 
 
 def cpu_receivers(plan: BakePlan) -> Receivers | None:
-    """The receivers the gather uploads, or None where its GPU raster lists them."""
-    if plan.layout.gpu_lists_receivers and plan.cells is None and GPU_TEXEL_LIST:
+    """The receivers the gather uploads, or None where its GPU raster lists them (a run of
+    some cells keeps the raster's entries in them: a cell's sample points are then the whole
+    bake's, where a CPU raster may put a point on a shared UV edge into the other face)."""
+    if plan.layout.gpu_lists_receivers and GPU_TEXEL_LIST:
         return None
     return plan.receivers()
 
@@ -93,7 +87,7 @@ def views_per_dispatch(plan: BakePlan) -> int:
     return math.ceil(directions / batches)
 
 
-class GatherBaker(LightViewBaker):
+class GatherBaker(TexelList, LightViewBaker):
     """Owns the depth map, the texel list and its accumulators for one bake."""
 
     METHOD = "gather"
@@ -177,7 +171,8 @@ class GatherBaker(LightViewBaker):
         self.receivers = cpu_receivers(self.plan)
         if self.receivers is not None:
             return None
-        faces = self.plan.target_faces
+        plan = self.plan if self.plan.cells is None else faces_reaching_cells(self.plan)
+        faces = plan.target_faces
         bins = normal_bins(faces[:, :3])
         if self.plan.smooth_shading:
             # An entry weighs in wherever its shading normal faces the light: the texel list
@@ -185,7 +180,7 @@ class GatherBaker(LightViewBaker):
             self.bin_axis, self.bin_threshold = cell_cones()
         else:
             self.bin_axis, self.bin_threshold = bin_cones(faces[:, :3], bins, faces[:, 3] > 0.0)
-        return plan_batch(self.plan, with_occluders=False, face_bins=bins, lift_corners=self.plan.lifts_terminator)
+        return plan_batch(plan, with_occluders=False, face_bins=bins, lift_corners=plan.lifts_terminator)
 
     def _views_fitted(self, indices: list[int], views: list) -> None:
         """Hole runs (core/bake/face_chunks.py) of a batch of views, found together."""
@@ -194,102 +189,6 @@ class GatherBaker(LightViewBaker):
             runs = hole_chunk_ranges_many(self.chunks, self.plan.holes, np.stack([v.matrix for v in views]),
                                           len(self.chunks.order))
             self.hole_runs = dict(zip(indices, runs))
-
-    def _allocate_list(self, count: int, uploaded: tuple[np.ndarray, ...] | None = None) -> None:
-        """The list textures for `count` entries (LIST_WIDTH per row) and zeroed sums;
-        uploaded: (position (count, 4), normal (count, 4)[, lift (count, 4)]) float32 to fill
-        them with (the texel of each entry then stays on the CPU: only accumulated() reads it)."""
-        size = self.plan.settings.size
-        self.entry_count = count
-        self.entry_cells = None  # read back once, at the first readback of sums
-        rows = util.list_rows(count)
-        if rows > gpu.capabilities.max_texture_size_get():
-            raise BakeInputError(f"{count} covered texels exceed this GPU's texture limit; use a smaller map")
-        if count > size * size:  # overlapping UV islands or sub-texel samples: more entries than texels
-            util.check_texture_limits(size, self.plan.max_view_side,
-                                      count * entry_bytes(self.plan) + self.plan.max_view_side**2 * 8)
-        shape = (LIST_WIDTH, rows)
-        self.entry_lift = None
-        if uploaded is None:
-            self.entry_position = gpu.types.GPUTexture(shape, format='RGBA32F')
-            self.entry_normal = gpu.types.GPUTexture(shape, format='RGBA32F')
-            self.entry_texel = gpu.types.GPUTexture(shape, format='R32UI')
-            if self.lifted:
-                self.entry_lift = gpu.types.GPUTexture(shape, format='RGBA32F')
-        else:
-            self.entry_position, self.entry_normal = (util.list_texture(v, 'RGBA32F') for v in uploaded[:2])
-            if len(uploaded) > 2:
-                self.entry_lift = util.list_texture(uploaded[2], 'RGBA32F')
-        channels = self.plan.estimator.channel_count
-        self.accums = [gpu.types.GPUTexture(shape, format=fmt) for fmt in ACCUM_FORMATS[channels]]
-        for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels]):
-            accum.clear(format='FLOAT', value=(0.0,) * FORMAT_CHANNELS[fmt])
-
-    def _upload_texel_list(self, receivers: Receivers) -> None:
-        """The list from CPU receivers: sorted by the normal bin of their shading normal (the
-        one their weight is about), both normals octahedral-encoded (the SHADING_NORMALS layout)."""
-        receivers = receivers.subset(receivers.inv_s > 0.0)
-        bins = normal_bins(receivers.shading)
-        order = np.argsort(bins, kind="stable")
-        bins = bins[order]
-        self.bin_axis, self.bin_threshold = bin_cones(receivers.shading[order], bins, np.ones(len(bins), bool))
-        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=BIN_COUNT))]).astype(np.int64)
-        position = np.concatenate([receivers.points[order], receivers.inv_s[order, None]], axis=1)
-        normal = np.concatenate([octahedral_coords(receivers.shading[order]),
-                                 octahedral_coords(receivers.geometric[order])], axis=1)
-        self.entry_texels = receivers.texel[order]
-        uploaded = [position.astype(np.float32), normal.astype(np.float32)]
-        if self.lifted:
-            lift = np.zeros((len(order), 4), np.float32)
-            lift[:, :3] = receivers.lift[order]
-            uploaded.append(lift)
-        self._allocate_list(len(order), tuple(uploaded))
-
-    def _build_texel_list(self) -> None:
-        """Count the target's UV-space fragments per normal bin, allocate the list at that
-        size with each bin's entries together, fill it (or upload cpu_receivers)."""
-        if self.receivers is not None:
-            self._upload_texel_list(self.receivers)
-            return
-        size = self.plan.settings.size
-        counter = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32UI')
-        uv_target = gpu.types.GPUTexture((size, size), format='R8')
-        uv_fb = gpu.types.GPUFrameBuffer(color_slots=uv_target)
-
-        def draw(shader) -> None:
-            counter.clear(format='UINT', value=(0,))
-            with util.scoped_state(), uv_fb.bind():
-                util.set_overlay_pass_state(size, size)
-                shader.bind()
-                shader.image("bin_count", counter)
-                if shader is fill:
-                    shader.uniform_int("capacity", count)
-                    shader.image("entry_position", self.entry_position)
-                    shader.image("entry_normal", self.entry_normal)
-                    shader.image("entry_texel", self.entry_texel)
-                    shader.image("bin_start", bin_start)
-                    if self.lifted:
-                        shader.image("entry_lift", self.entry_lift)
-                self.target_batch.draw(shader)
-            util.image_barrier()
-
-        fill = texel_list_shader(True, self.plan.smooth_shading, self.lifted)
-        draw(texel_list_shader(False, self.plan.smooth_shading, self.lifted))
-        per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
-        count = int(per_bin.sum())
-        self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
-        self._allocate_list(count)
-        # Only FLOAT buffers upload: the uint32 starts travel as float bits (floatBitsToUint).
-        starts = self.bin_first[:-1].astype(np.uint32).view(np.float32)
-        bin_start = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32F',
-                                         data=gpu.types.Buffer('FLOAT', BIN_COUNT, starts))
-        draw(fill)
-        # Both passes bin each fragment by the same arithmetic on the same inputs; a GPU whose
-        # two variants rounded a shading normal differently would have filled a neighbour's range.
-        filled = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
-        if not np.array_equal(filled, per_bin):
-            raise RuntimeError(f"the texel list's fill pass binned {int(np.abs(filled - per_bin).sum())} entries "
-                               f"differently from its count pass")
 
     def _entry_runs(self, omegas: np.ndarray) -> list[tuple[int, int]]:
         """(first entry, end entry) runs of the bins that can face one of omegas (k, 3)."""
@@ -409,15 +308,17 @@ class GatherBaker(LightViewBaker):
         block = self.views_data[0]
         self.views_data.view(np.float32)[:] = 0.0
         for k, view in enumerate(views):
-            block["view_proj"][k] = view.matrix.T  # column-major for GLSL
+            grid = view.whole or view  # a cropped view is read on its whole view's pixel grid
+            block["view_proj"][k] = grid.matrix.T  # column-major for GLSL
             # With view_proj's entries, which the texel test loads anyway, this gives a receiver
             # plane's depth slope: a second (inverse-transpose) matrix's nine loads per view made
             # the smooth bunny's texel tests 17 % slower on llvmpipe (96 directions: 0.85 s
             # against 0.71 s, medians of 8 interleaved).
-            block["plane_slope"][k][:2] = view.plane_slope()
+            block["plane_slope"][k][:2] = grid.plane_slope()
             block["omega"][k] = (*view.omega, 0.0)
-            span = view.depth_far - view.depth_near
-            block["view_info"][k] = (view.width, view.height, view.pixel_size / span, span)
+            span = grid.depth_far - grid.depth_near
+            block["view_info"][k] = (grid.width, grid.height, grid.pixel_size / span, span)
+            block["window"][k] = (*view.first, view.width, view.height)
         self.views_block.update(self.views_data.view(np.float32))
         settings = self.plan.settings
         # One variant per bake: a last, short batch fills the other slots with padding (omega 0).
@@ -479,15 +380,3 @@ class GatherBaker(LightViewBaker):
         parts = [util.texture_to_numpy(accum, np.float32).reshape(-1, FORMAT_CHANNELS[fmt])[:n]
                  for accum, fmt in zip(self.accums, ACCUM_FORMATS[channels])]
         return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
-
-    def _entry_cells(self) -> np.ndarray:
-        """(entry_count,) int each entry's flat texel index, read back once."""
-        if self.receivers is not None:
-            return self.entry_texels
-        if self.entry_cells is None:
-            size = self.plan.settings.size
-            texel = util.texture_to_numpy(self.entry_texel, np.uint32).ravel()[:self.entry_count]
-            # int32 where it fits: 64 MB at 4096^2 (16M entries), kept for the bake
-            kind = np.int32 if np.prod(self.plan.output_shape) < 2 ** 31 else np.int64
-            self.entry_cells = (texel >> 16).astype(kind) * kind(size) + (texel & 0xFFFF).astype(kind)
-        return self.entry_cells

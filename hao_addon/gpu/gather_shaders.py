@@ -88,14 +88,18 @@ def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = Fals
 # <= that of them used. view_proj maps normalized world to the view's clip space; plane_slope.xy
 # turns the image of a plane's normal under it into the plane's depth change per pixel
 # (core/bake/views.OrthoView.plane_slope); omega points towards the light; view_info is
-# (width, height, one pixel's extent in depth units, the depth range in normalized units). A
+# (width, height, one pixel's extent in depth units, the depth range in normalized units);
+# window is (first x, first y, width, height) of the pixels its depth map holds (a view
+# cropped from a whole one, OrthoView.whole: the other fields are the whole view's, and the
+# map holds only the crop's pixels). A
 # uniform buffer, because four views' push constants would pass the 128 bytes some backends
 # guarantee.
 GATHER_MAX_VIEWS = 16
 GATHER_VIEWS_DTYPE = np.dtype([("view_proj", "<f4", (GATHER_MAX_VIEWS, 4, 4)),
                                ("plane_slope", "<f4", (GATHER_MAX_VIEWS, 4)),
                                ("omega", "<f4", (GATHER_MAX_VIEWS, 4)),
-                               ("view_info", "<f4", (GATHER_MAX_VIEWS, 4))])
+                               ("view_info", "<f4", (GATHER_MAX_VIEWS, 4)),
+                               ("window", "<f4", (GATHER_MAX_VIEWS, 4))])
 # The gather's depth slack (gpu_shaders/bake_gather.comp, plane_lookup): the receiver's own
 # plane is extrapolated to the depth map's pixel centre exactly, and the comparison allows
 # DEPTH_BIAS_PIXELS of depth plus SLOPE_BIAS_PIXELS pixels' worth of that plane's slope, for

@@ -89,14 +89,13 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
     spheres = np.asarray(spheres, np.float64).reshape(-1, 4)
     directions = np.asarray(directions, np.float64).reshape(-1, 3)
     spread_cos = 0.0 if spread_angle >= 90.0 else float(np.cos(np.radians(spread_angle)))
+    if normals.shape[1] > 1 and (normals == normals[:, :1]).all():
+        normals = normals[:, :1]  # flat faces: one normal does for every corner
     bound = np.zeros(len(points))
     rows = max(1, BLOCK * 4 // max(len(directions), 1))
     for start in range(0, len(points), rows):
-        p, n = points[start:start + rows], normals[start:start + rows]
-        weights = hemisphere_weight(n @ directions.T, weighting, spread_cos)  # (b, m, D)
-        weight = weights.max(axis=1)
-        total = np.maximum(weights.sum(axis=2).min(axis=1), 1e-300)
-        inside = np.zeros(weight.shape, bool)
+        p = points[start:start + rows]
+        inside = np.zeros((len(p), len(directions)), bool)
         for centre, sphere_radius in zip(spheres[:, :3], spheres[:, 3]):
             radius = sphere_radius + reach[start:start + len(p)]
             to = centre - p
@@ -109,7 +108,12 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
             cos_t = np.sqrt(np.maximum(1.0 - (radius / np.maximum(dist, 1e-300)) ** 2, 0.0))
             aim = (to / np.maximum(dist, 1e-300)[:, None]) @ directions.T  # (b, D)
             inside |= (~near)[:, None] | (near_enough[:, None] & (aim >= cos_t[:, None]))
-        bound[start:start + len(p)] = np.minimum((weight * inside).sum(axis=1) / total, 1.0)
+        # Only receivers with a direction into a sphere weigh their directions (most do not).
+        hit = np.flatnonzero(inside.any(axis=1))
+        weights = hemisphere_weight(normals[start + hit] @ directions.T, weighting, spread_cos)  # (h, m, D)
+        total = np.maximum(weights.sum(axis=2).min(axis=1), 1e-300)
+        share = (weights.max(axis=1) * inside[hit]).sum(axis=1) / total
+        bound[start + hit] = np.minimum(share, 1.0)
     return bound
 
 
@@ -139,7 +143,8 @@ def face_box_bounds(uvs: np.ndarray, bound: np.ndarray, size: int, grid: int) ->
     return coarse.reshape(grid, grid)[rows[:, None], rows[None, :]]
 
 
-# Pieces a bound is computed over, at most (face_pieces): a few hundred MB of arrays.
+# Pieces a bound is computed over, at most (face_pieces, refined_piece_bounds): a few hundred
+# MB of arrays.
 MAX_PIECES = 1 << 21
 
 
@@ -175,3 +180,32 @@ def face_pieces(*per_corner: np.ndarray, radius: float) -> list[np.ndarray]:
             pieces = np.einsum("pck,fk...->fpc...", bary, array[faces])
             parts[k].append(pieces.reshape(-1, *array.shape[1:]))
     return [np.concatenate(p) for p in parts]
+
+
+def quartered(*per_corner: np.ndarray) -> list[np.ndarray]:
+    """The faces of per_corner arrays (each (F, 3, ...)) each cut into 4 like triangles."""
+    bary = _subdivision(2)
+    return [np.einsum("pck,fk...->fpc...", bary, array).reshape(-1, *array.shape[1:]) for array in per_corner]
+
+
+def refined_piece_bounds(world: np.ndarray, uvs: np.ndarray, normals: np.ndarray, bound_of, threshold: float,
+                         radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """(uvs (P, 3, 2), bound (P,)) of pieces of the faces (world (F, 3, 3), uvs, normals (F,
+    3, 3)): each face's bound_of(spheres (k, 4), normals (k, 3, 3)) -> (k,), a bound over
+    every point of a piece's sphere, and pieces at or above threshold cut in 4 again until no
+    wider than radius (or MAX_PIECES are cut): where an edit cannot reach the threshold, one
+    coarse piece answers for a whole face; only near it are pieces fine."""
+    from .scene_changes import face_spheres  # the same sphere a state records per face
+
+    done_uvs, done_bounds = [], []
+    while len(world):
+        spheres = face_spheres(world)
+        bound = bound_of(spheres, normals)
+        cut = (bound >= threshold) & (spheres[:, 3] > radius)
+        if 4 * int(cut.sum()) > MAX_PIECES:
+            cut[:] = False
+        done_uvs.append(uvs[~cut])
+        done_bounds.append(bound[~cut])
+        world, uvs, normals = quartered(world[cut], uvs[cut], normals[cut])
+    return np.concatenate(done_uvs), np.concatenate(done_bounds)
+

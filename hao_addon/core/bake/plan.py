@@ -16,7 +16,7 @@ from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
                         surface_holes, uv_areas, weld)
-from .abilities import abilities_needed, check_method, choose_method
+from .abilities import abilities_needed, check_method, choose_method, declaration
 from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
 from .normalization import corner_normalizers, face_normalizers
@@ -67,6 +67,9 @@ class BakePlan:
     max_view_side: int
     target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
     drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
+    # (m, 3) float64 normalized, or None: a run of some cells crops each view to these points
+    # (views.fit_views: the whole bake's pixel grid and depth range).
+    window_points: np.ndarray | None = None
     needs_footprint_splat: bool = False
     # Some corner's shading normal differs from its face normal: the passes then weight by
     # the shading normal and handle the terminator (directions above the shading hemisphere
@@ -214,19 +217,22 @@ class BakePlan:
         c, r = self.drawn_sphere
         reaches = [float(omega @ c) + r for omega in omegas]
         jitters = np.array([pixel_jitter(self.seed, i) for i in indices]).reshape(-1, 2)
-        return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side)
+        return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side,
+                         self.window_points)
 
 
-def _view_corners(t_pos: np.ndarray, target_weld, target, settings: BakeSettings, run: BakeRun,
-                  layout: TexelLayout) -> np.ndarray:
-    """(n, 3) normalized target corners a light view's window is fitted to: the distinct ones,
-    or, for a run of some texels of one UV tile (an incremental re-bake's cells), the corners of
-    the faces that reach them: each view then covers only their part of the scene (a ray from a
-    receiver stays inside its window), and costs that part's pixels."""
-    if run.cells is None or layout.KIND != "texel" or layout.udim is not None or target.uvs is None:
-        return t_pos.reshape(-1, 3)[target_weld[0]]
+def _window_corners(t_pos: np.ndarray, target, settings: BakeSettings, run: BakeRun,
+                    layout: TexelLayout, method: str) -> np.ndarray | None:
+    """(n, 3) normalized corners a run of some texels of one UV tile (an incremental re-bake's
+    cells) crops its light views to: those of the faces that reach them. Each view then
+    covers only their part of the whole bake's view (a ray from a receiver stays inside its
+    window), and costs that part's pixels. None: the whole views (and for a baker that bakes
+    every texel, abilities.bakes_all_cells)."""
+    if (run.cells is None or declaration(method).bakes_all_cells or layout.KIND != TexelLayout.KIND
+            or layout.udim is not None or target.uvs is None):
+        return None
     faces = faces_touching(target.uvs, settings.size, run.cells)
-    return t_pos[faces].reshape(-1, 3) if len(faces) else t_pos.reshape(-1, 3)[target_weld[0]]
+    return t_pos[faces].reshape(-1, 3) if len(faces) else None
 
 
 # The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets
@@ -308,20 +314,19 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
                         holes, smooth_corners, uv_warnings + layout.warnings, alpha, {**uv_counters, **layout.counters})
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
-    view_corners = _view_corners(t_pos, target_weld, target, settings, run, layout)
-    # A view's side is at most the diameter of what it is fitted to: the whole target's (extent
-    # about the origin), or the part a run of some cells fits its views to.
-    reach = extent if run.cells is None else min(extent, float(np.linalg.norm(
-        view_corners - 0.5 * (view_corners.min(0) + view_corners.max(0)), axis=1).max()))
+    # A view's side is at most the diameter of the whole target (extent about the origin); a
+    # run of some cells draws a window of such views (views.fit_views).
+    window = _window_corners(t_pos, target, settings, run, layout, method)
     return BakePlan(
         settings=settings, run=run, layout=layout, method=method, centre=centre, scale=scale,
         target_positions=t_pos.astype(np.float32), target_uvs=uvs.astype(np.float32),
         target_faces=np.concatenate([normals, inv_s[:, None]], axis=1).astype(np.float32), target_corners=corners,
         target_above=above, occluder_positions=o_pos.astype(np.float32),
         occluder_normals=np.asarray(o_normals, dtype=np.float32), directions=directions, pixel_size=pixel_size,
-        max_view_side=int(np.ceil(2.0 * reach / pixel_size)) + 4,
+        max_view_side=int(np.ceil(2.0 * extent / pixel_size)) + 4,
         # Distinct corners: a light view's window is fitted to them (shared corners once).
-        target_points=layout.view_points(view_corners, pixel_size),
+        target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
+        window_points=window,
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
         smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
         stats=stats, alpha=alpha)

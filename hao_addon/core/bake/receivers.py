@@ -93,15 +93,25 @@ def interpolate_unit(corners: np.ndarray, face: np.ndarray, bary: np.ndarray) ->
     return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
 
 
+# faces_touching marks cells on a grid at most this fine (a face reaching a marked grid cell
+# is kept: a few more faces than those reaching the texels themselves, at a summed-area
+# table's cost that does not grow with the map: 0.18 s a call at 2048^2 on the texels).
+TOUCH_GRID = 512
+
+
 def faces_touching(uvs: np.ndarray, size: int, cells: np.ndarray) -> np.ndarray:
-    """(k,) int64 the faces whose UV box (grown by a texel) holds one of cells (flat y * size +
-    x of one 0..1 tile): every face that can put a sample point into them, in face order."""
-    mark = np.zeros((size + 1, size + 1), np.int64)  # a summed-area table of the cells
-    mark[1:, 1:] = np.bincount(np.asarray(cells, np.int64), minlength=size * size).reshape(size, size)
+    """(k,) int64 the faces whose UV box (grown by a texel) reaches a cell of a TOUCH_GRID
+    raster that holds one of cells (flat y * size + x of one 0..1 tile): every face that can
+    put a sample point into them, and a few beside, in face order."""
+    grid = min(size, TOUCH_GRID)
+    cells = np.asarray(cells, np.int64)
+    coarse = (cells // size * grid // size) * grid + cells % size * grid // size
+    mark = np.zeros((grid + 1, grid + 1), np.int32)  # a summed-area table of the marked cells
+    mark[1:, 1:] = np.bincount(coarse, minlength=grid * grid).reshape(grid, grid) > 0
     table = mark.cumsum(0).cumsum(1)
     p = uvs * size
-    lo = np.clip(np.floor(p.min(axis=1)) - 1, 0, size).astype(np.int64)
-    hi = np.clip(np.ceil(p.max(axis=1)) + 1, 0, size).astype(np.int64)
+    lo = np.clip((np.floor(p.min(axis=1)) - 1) * grid // size, 0, grid).astype(np.int64)
+    hi = np.clip(-(-(np.ceil(p.max(axis=1)) + 1) * grid // size) + 1, 0, grid).astype(np.int64)
     inside = table[hi[:, 1], hi[:, 0]] - table[lo[:, 1], hi[:, 0]] - table[hi[:, 1], lo[:, 0]] + table[lo[:, 1], lo[:, 0]]
     return np.flatnonzero(inside > 0)
 

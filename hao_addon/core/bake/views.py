@@ -8,7 +8,7 @@ scene's scale or distance from the origin: a mesh 1e5 units away keeps its preci
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -28,6 +28,12 @@ class OrthoView:
     pixel_size: float
     depth_near: float
     depth_far: float
+    # A view cropped from a whole one (a run of some texels, fit_views' window_points): that
+    # view, and the whole view's pixel where this one's first pixel lies. A test of a receiver
+    # against the cropped depth map reads it through the whole view's matrix (the same pixel
+    # and depth arithmetic as the whole bake's), offset by `first`.
+    whole: "OrthoView | None" = None
+    first: tuple[int, int] = (0, 0)
 
     def plane_slope(self) -> np.ndarray:
         """(2,) float64 c: a plane of normal g has depth (clip z / 2 + 1 / 2) slope
@@ -70,32 +76,60 @@ def fit_view(omega: np.ndarray, target_points: np.ndarray, light_reach: float | 
 
 
 def fit_views(omegas: np.ndarray, target_points: np.ndarray, light_reaches: list[float | None],
-              pixel_size: float, jitters: np.ndarray, max_side: int) -> list[OrthoView]:
+              pixel_size: float, jitters: np.ndarray, max_side: int,
+              window_points: np.ndarray | None = None) -> list[OrthoView]:
     """fit_view for k directions at once: omegas (k, 3), light_reaches (k,), jitters (k, 2).
     One (3k, 3) x (3, n) product and one pass of row reductions serve all k views (per view,
-    numpy's call overhead was most of the 0.5 ms a fit took on the bunny's 35k points)."""
+    numpy's call overhead was most of the 0.5 ms a fit took on the bunny's 35k points).
+    window_points: (m, 3) or None: each view is then the views of target_points cropped to
+    the pixels that cover these points' projection, on the same pixel grid and depth range (a
+    run of some texels reads the same depth-map values as the whole bake)."""
     bases = np.stack([light_basis(omega) for omega in omegas])  # (k, 3, 3)
+    lo_rows, hi_rows = _projected_extents(bases, target_points)
+    crops = [None] * len(bases) if window_points is None else zip(*_projected_extents(bases, window_points))
+    return [_view_from_extent(basis, lo_all, hi_all, reach, pixel_size, jitter, max_side, crop)
+            for basis, lo_all, hi_all, reach, jitter, crop in zip(bases, lo_rows, hi_rows, light_reaches, jitters,
+                                                                  crops)]
+
+
+def _projected_extents(bases: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 3) lowest and highest u, v, w of points (n, 3) in each basis of bases (k, 3, 3)."""
     # (3k, n) u, v, w rows: reductions along contiguous rows are about 5x faster than down the
     # columns of an (n, 3) array.
-    proj = bases.reshape(-1, 3) @ np.asarray(target_points, np.float64).T
-    lo_rows, hi_rows = proj.min(axis=1).reshape(-1, 3), proj.max(axis=1).reshape(-1, 3)
-    return [_view_from_extent(basis, lo_all, hi_all, reach, pixel_size, jitter, max_side)
-            for basis, lo_all, hi_all, reach, jitter in zip(bases, lo_rows, hi_rows, light_reaches, jitters)]
+    proj = bases.reshape(-1, 3) @ np.asarray(points, np.float64).T
+    return proj.min(axis=1).reshape(-1, 3), proj.max(axis=1).reshape(-1, 3)
 
 
 def _view_from_extent(basis: np.ndarray, lo_all: np.ndarray, hi_all: np.ndarray, light_reach: float | None,
-                      pixel_size: float, jitter: np.ndarray, max_side: int) -> OrthoView:
-    """The view of light basis (3, 3) whose target spans lo_all..hi_all (3,) in u, v, w."""
+                      pixel_size: float, jitter: np.ndarray, max_side: int,
+                      crop: tuple[np.ndarray, np.ndarray] | None = None) -> OrthoView:
+    """The view of light basis (3, 3) whose target spans lo_all..hi_all (3,) in u, v, w;
+    with crop (its lowest and highest u, v, w), only its pixels that cover crop's u, v
+    (and the one beyond each side), as a view cropped from the whole one (OrthoView.whole)."""
     lo = lo_all[:2] - pixel_size * (1.0 + jitter)
     hi = hi_all[:2] + pixel_size
     size = np.ceil((hi - lo) / pixel_size).astype(int)
     width, height = (int(min(max(s, 1), max_side)) for s in size)
-    hi = lo + np.array([width, height]) * pixel_size  # square pixels exactly
     zlo, zhi = float(lo_all[2]), float(hi_all[2])
     if light_reach is not None:
         zhi = max(zhi, light_reach)
     pad = 1e-3 * max(zhi - zlo, 1e-6)
-    zlo, zhi = zlo - pad, zhi + pad
+    whole = _ortho_view(basis, lo, (width, height), pixel_size, zlo - pad, zhi + pad)
+    if crop is None:
+        return whole
+    # Whole pixels first..end of the whole view's grid.
+    size = np.array([width, height])
+    first = np.clip(np.floor((crop[0][:2] - pixel_size - lo) / pixel_size), 0, size - 1).astype(int)
+    end = np.clip(np.ceil((crop[1][:2] + pixel_size - lo) / pixel_size), first + 1, size).astype(int)
+    view = _ortho_view(basis, lo + first * pixel_size, end - first, pixel_size, zlo - pad, zhi + pad)
+    return replace(view, whole=whole, first=(int(first[0]), int(first[1])))
+
+
+def _ortho_view(basis: np.ndarray, lo: np.ndarray, size, pixel_size: float, zlo: float, zhi: float) -> OrthoView:
+    """The view of light basis (3, 3) whose window starts at u, v lo (2,) and is size (width,
+    height) pixels, its depth range zlo..zhi."""
+    width, height = int(size[0]), int(size[1])
+    hi = lo + np.array([width, height]) * pixel_size  # square pixels exactly
     # NDC: x, y in [-1, 1] over the window; depth: w = zhi (nearest the light) -> -1, zlo -> +1.
     sx, sy = (float(x) for x in 2.0 / (hi - lo))
     tx, ty = (float(x) for x in -(hi + lo) / (hi - lo))
