@@ -59,6 +59,10 @@ class BakeResult:
     error: ErrorEstimate | None = None
     # The bake method that ran (the plan's choice, BakePlan.method; stats["method"] reports it).
     method: str = ""
+    # An incremental re-bake's (hao_addon/rebake.py): each cell's bound on how far it lies from
+    # a whole bake of its scene (ao's shape, float32): 0 where baked, a kept cell's bounds
+    # added up over the re-bakes that kept it. None: every cell is baked.
+    kept_offset: np.ndarray | None = None
 
     def error_map(self) -> np.ndarray | None:
         """ao's shape float32: each texel's estimated error (its neighbourhood's RMS twin)."""

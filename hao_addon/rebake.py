@@ -2,18 +2,22 @@
 """Re-bake only what an edit changed, with a stated bound on what is kept.
 
 A bake records its scene (core/bake/scene_changes.SceneState: the settings' key, the target's
-layout, every soup's chunks). The next bake of the same target compares the edited scene's
-state with it: the changed chunks' spheres, before and after, bound how much each receiver's
-AO can have moved (core/bake/change_bound.py, (r / D)^2 for cosine weighting); cells whose
-bound stays below KEEP_SHARE of the map's stated RMSE keep their value, the others are baked
-again (the plan's cells: only the bakers that bake a subset spend less), and the map's margins
-grow again from the merged values. A change of any setting that changes pixels, of the
-target's UVs or faces, a bake to an error, bent normals, colour attributes and UDIM tiles re-bake
-in full (said in the report).
+layout, every soup's faces). The next bake of the same target compares the edited scene's
+state with it: the changed faces' spheres, before and after, bound how far each texel's value
+can lie from a whole bake of the edited scene (core/bake/change_bound.sampled_change_bound:
+the share of the bake's own directions that enter them); cells whose bound stays below
+KEEP_SHARE of the map's stated RMSE keep their value, the others are baked again (the plan's
+cells: only the bakers that bake a subset spend less, abilities.bakes_all_cells), and the
+map's margins grow again from the merged values. A change of any setting that changes pixels,
+of the target's UVs or faces, a bake to an error, bent normals, colour attributes, UDIM tiles,
+Selected to Active and a baker that bakes every texel re-bake in full (said in the report).
 Nothing here touches Blender data.
 """
 from __future__ import annotations
 
+import dataclasses
+import io
+import json
 import math
 from dataclasses import dataclass, field, replace
 from typing import Generator
@@ -22,13 +26,13 @@ import numpy as np
 
 from .bake import BakeResult, bake_cells_steps, bake_steps, regrown
 from .core.bake.abilities import declaration
-from .core.bake.change_bound import cell_bound, change_bound, face_box_bounds, refined_piece_bounds, \
-    sampled_change_bound
+from .core.bake.change_bound import cell_bound, face_box_bounds, refined_piece_bounds, sampled_change_bound
 from .core.bake.error_estimate import ErrorEstimate, estimate
 from .core.bake.plan import make_plan_steps
-from .core.bake.scene_changes import SceneState, changed_spheres, scene_state
+from .core.bake.scene_changes import SceneState, SoupState, changed_spheres, scene_state
 from .core.bake.settings import BakeSettings
 from .core.bake.target_kinds import target_kind
+from .core.bake.targets import BakeTarget
 from .core.bake.udim import udim_layout
 from .core.geometry import TriangleSoup
 from .core.steps import drain, relay
@@ -57,7 +61,8 @@ class RebakeReport:
         if self.full:
             return f"re-baked in full: {self.why}"
         return (f"re-baked {self.rebaked} of {self.covered} texels ({self.why}); the {self.covered - self.rebaked} "
-                f"kept are within {self.kept_bound:.2g} of the edited scene's AO (kept below {self.threshold:.2g})")
+                f"kept are within {self.kept_bound:.2g} of a whole bake of the edited scene (kept below "
+                f"{self.threshold:.2g})")
 
     def as_dict(self) -> dict:
         return {"full": self.full, "why": self.why, "rebaked": self.rebaked, "covered": self.covered,
@@ -79,6 +84,8 @@ def _full_reason(previous: BakeResult | None, before: SceneState | None, after: 
     """Why this re-bake cannot keep anything, or ''."""
     if previous is None or before is None:
         return "no earlier bake of this target"
+    if previous.tiles is not None or previous.ao.shape != (settings.size, settings.size):
+        return "the earlier bake's map is of another layout"
     if before.settings_key != after.settings_key:
         return "a setting that changes pixels changed"
     if before.target_layout != after.target_layout:
@@ -96,40 +103,68 @@ def _full_reason(previous: BakeResult | None, before: SceneState | None, after: 
     return ""
 
 
-def rebake_steps(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup,
+def rebake_steps(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup | BakeTarget,
                  occluders: list[TriangleSoup], settings: BakeSettings
                  ) -> Generator[float, None, tuple[BakeResult, SceneState, RebakeReport]]:
     """The edited scene's bake, from previous (a bake of before's scene with the same settings)
     where the edit cannot have changed a cell by KEEP_SHARE of its stated RMSE; yields progress.
-    Returns (the map, the state to record for the next re-bake, what was done)."""
+    Returns (the map, the state to record for the next re-bake, what was done); the map's
+    stats carry the report ('rebake')."""
+    bake_target = target
+    target = target.soup if isinstance(target, BakeTarget) else target
     after = record(target, occluders, settings)
     reason = _full_reason(previous, before, after, target, settings)
+    if not reason and isinstance(bake_target, BakeTarget) and bake_target.high_to_low is not None:
+        reason = "Selected to Active is re-baked in full"
+    plan = None
+    if not reason:
+        plan = yield from relay(make_plan_steps(target, occluders, settings), lambda f: 0.05 * f)
+        if declaration(plan.method).bakes_all_cells:
+            reason = (f"the {declaration(plan.method).label} bakes every texel (Method: Gather re-bakes part of a "
+                      f"map)")
     if reason:
-        result = yield from bake_steps(target, occluders, settings, use_cache=False)
-        return result, after, RebakeReport(True, reason, int(result.covered.sum()), int(result.covered.sum()))
+        result = yield from bake_steps(bake_target, occluders, settings, use_cache=False)
+        report = RebakeReport(True, reason, int(result.covered.sum()), int(result.covered.sum()))
+        return _reported(result, result.stats, report), after, report
     spheres = changed_spheres(before, after)
     covered = int(previous.covered.sum())
+    stats = {**plan.stats, "method": plan.method, "covered_texels": covered, "cache_hit": False}
     if len(spheres) == 0:
         yield 1.0
-        return previous, after, RebakeReport(False, "nothing changed", 0, covered)
+        report = RebakeReport(False, "nothing changed", 0, covered)
+        return _reported(previous, stats, report), after, report
     threshold = KEEP_SHARE * previous.error.rmse
-    bounds = yield from relay(_cell_bounds(target, occluders, settings, spheres, threshold), lambda f: 0.1 * f)
+    # A cell kept by earlier re-bakes already lies up to their bounds from its scene's bake.
+    carried = 0.0 if previous.kept_offset is None else previous.kept_offset.reshape(-1).astype(np.float64)
+    bounds = carried + _cell_bounds(plan, spheres, settings, threshold)
     redo = previous.covered.reshape(-1) & (bounds >= threshold)
     kept = previous.covered.reshape(-1) & ~redo
     kept_bound = float(bounds[kept].max()) if kept.any() else 0.0
+    offset = np.where(kept, bounds, 0.0).astype(np.float32).reshape(previous.covered.shape)
     why = f"{len(spheres)} changed parts"
     if not redo.any():
         yield 1.0
-        kept = replace(previous, error=_with_bound(previous.error, previous.error, kept_bound))
-        return kept, after, RebakeReport(False, why, 0, covered, kept_bound, threshold)
+        report = RebakeReport(False, why, 0, covered, kept_bound, threshold)
+        noise = previous.error if previous.twin is None else estimate(previous.twin, previous.covered,
+                                                                      previous.error.directions)
+        kept = replace(previous, error=_with_bound(noise, previous.error, kept_bound), kept_offset=offset)
+        return _reported(kept, stats, report), after, report
     cells = np.flatnonzero(redo)
     part = yield from relay(bake_cells_steps(target, occluders, settings, cells), lambda f: 0.1 + 0.9 * f)
-    merged = _merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound)
-    return merged, after, RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells)
+    report = RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells)
+    merged = replace(_merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound),
+                     kept_offset=offset)
+    return _reported(merged, {**stats, **part.stats, "covered_texels": covered}, report), after, report
 
 
-def rebake(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup, occluders: list[TriangleSoup],
-           settings: BakeSettings) -> tuple[BakeResult, SceneState, RebakeReport]:
+def _reported(result: BakeResult, stats: dict, report: RebakeReport) -> BakeResult:
+    """result with stats, its error and the re-bake's report among them."""
+    error = None if result.error is None else result.error.as_dict()
+    return replace(result, stats={**stats, "error": error, "rebake": report.as_dict()}, method=stats["method"])
+
+
+def rebake(previous: BakeResult | None, before: SceneState | None, target: TriangleSoup | BakeTarget,
+           occluders: list[TriangleSoup], settings: BakeSettings) -> tuple[BakeResult, SceneState, RebakeReport]:
     """rebake_steps, drained."""
     return drain(rebake_steps(previous, before, target, occluders, settings))
 
@@ -152,14 +187,16 @@ RECEIVER_BOUND_SIZE = 512
 PIECE_SHARE = 0.25
 
 
-def _cell_bounds(target: TriangleSoup, occluders: list[TriangleSoup], settings: BakeSettings, spheres: np.ndarray,
-                 threshold: float) -> Generator[float, None, np.ndarray]:
-    """(cells,) a bound on each output cell's receivers in the edited scene: the larger of what
-    the AO can change by (change_bound) and what the bake's own directions can
-    (sampled_change_bound), at the receivers themselves or, for maps above
-    RECEIVER_BOUND_SIZE, at pieces of the target's faces painted over their UV boxes (cut
-    finer where they reach threshold)."""
-    plan = yield from make_plan_steps(target, occluders, settings)
+def _cell_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: float) -> np.ndarray:
+    """(cells,) a bound on how far each output cell's value can lie from a whole bake of the
+    edited scene (plan: that bake's): the weight share of the bake's own directions that
+    enter a changed sphere (sampled_change_bound; the same directions, so a direction that
+    meets no change reads the same visibility), at the receivers themselves or, for maps
+    above RECEIVER_BOUND_SIZE, at pieces of the target's faces painted over their UV boxes
+    (cut finer where they reach threshold). The hemisphere's own bound (change_bound, (r /
+    D)^2) is what this tends to at many directions; at few it is no bound on an estimate
+    (one direction into a small cone moves it by about 1 / D), and at 128 directions on an
+    8-unit floor it would re-bake every texel for a ball of 0.4 moved by 0.1."""
     slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
     grown = spheres + np.array([0.0, 0.0, 0.0, slack])
     if settings.size <= RECEIVER_BOUND_SIZE:
@@ -172,8 +209,7 @@ def _receiver_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.nd
     receivers = plan.receivers()
     world = receivers.points * plan.scale + plan.centre
     args = (settings.weighting, settings.spread_angle, settings.max_distance)
-    bound = np.maximum(change_bound(world, spheres, *args),
-                       sampled_change_bound(world, receivers.shading, spheres, plan.directions, *args))
+    bound = sampled_change_bound(world, receivers.shading, spheres, plan.directions, *args)
     return cell_bound(bound, receivers.texel, int(np.prod(plan.layout.output_shape)))
 
 
@@ -189,9 +225,7 @@ def _piece_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: 
 
     def bound_of(pieces: np.ndarray, corner_normals: np.ndarray) -> np.ndarray:
         unit = corner_normals / np.maximum(np.linalg.norm(corner_normals, axis=2, keepdims=True), 1e-30)
-        return np.maximum(change_bound(pieces[:, :3], spheres, *args, reach=pieces[:, 3]),
-                          sampled_change_bound(pieces[:, :3], unit, spheres, plan.directions, *args,
-                                               reach=pieces[:, 3]))
+        return sampled_change_bound(pieces[:, :3], unit, spheres, plan.directions, *args, reach=pieces[:, 3])
 
     uvs, bound = refined_piece_bounds(world, plan.target_uvs[lit].astype(np.float64), normals, bound_of, threshold,
                                       max(PIECE_SHARE * float(spheres[:, 3].min()), 0.5 * texel))
@@ -227,6 +261,51 @@ def _merged(previous: BakeResult, part: BakeResult, redo: np.ndarray, settings: 
     if previous.twin is not None and part.twin is not None:
         twin = np.where(fresh, part.twin, previous.twin).astype(np.float32)
         error = _with_bound(estimate(twin, previous.covered, previous.error.directions), previous.error, kept_bound)
-    stats = {**previous.stats, "cache_hit": False, "rebaked_texels": int(redo.sum()),
-             "error": None if error is None else error.as_dict()}
-    return replace(previous, ao=ao, twin=twin, error=error, stats=stats)
+    return replace(previous, ao=ao, twin=twin, error=error)
+
+
+# What a bake keeps beside its map for the next re-bake (the command line's sidecar file,
+# record_path): the scene's state and the float map with its masks and twins.
+RECORD_SUFFIX = ".hao-rebake.npz"
+RECORD_VERSION = 1
+
+
+def record_path(map_path: str) -> str:
+    """The record kept beside a map file."""
+    return map_path + RECORD_SUFFIX
+
+
+def record_bytes(state: SceneState, result: BakeResult) -> bytes:
+    """state and result (an image bake's: ao, covered, filled, twin, error, method) as an
+    .npz file's bytes."""
+    meta = {"version": RECORD_VERSION, "settings_key": state.settings_key, "target_layout": state.target_layout,
+            "soups": list(state.soups), "method": result.method,
+            "error": None if result.error is None else dataclasses.asdict(result.error)}
+    arrays = {"ao": result.ao, "covered": result.covered, "filled": result.filled}
+    for name in ("twin", "kept_offset"):
+        if getattr(result, name) is not None:
+            arrays[name] = getattr(result, name)
+    for k, soup in enumerate(state.soups.values()):
+        arrays[f"prints{k}"], arrays[f"spheres{k}"] = soup.fingerprints, soup.spheres
+    out = io.BytesIO()
+    np.savez_compressed(out, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8), **arrays)
+    return out.getvalue()
+
+
+def read_record(data: bytes) -> tuple[BakeResult, SceneState] | None:
+    """(the earlier bake, its scene's state) of record_bytes' bytes; None for a record this
+    version cannot read (a re-bake is then full, and says so)."""
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as npz:
+            meta = json.loads(bytes(npz["meta"]).decode())
+            if meta.get("version") != RECORD_VERSION:
+                return None
+            soups = {name: SoupState(npz[f"prints{k}"], npz[f"spheres{k}"]) for k, name in enumerate(meta["soups"])}
+            error = None if meta["error"] is None else ErrorEstimate(**meta["error"])
+            optional = {name: npz[name] if name in npz.files else None for name in ("twin", "kept_offset")}
+            result = BakeResult(npz["ao"], npz["covered"], npz["filled"], {"method": meta["method"]}, error=error,
+                                method=meta["method"], **optional)
+    except (OSError, ValueError, KeyError, TypeError, json.JSONDecodeError):
+        return None
+    return result, SceneState(meta["settings_key"], meta["target_layout"], soups)
+

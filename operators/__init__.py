@@ -3,11 +3,11 @@
 
 Registration never touches the GPU (background mode has none until a bake asks for it).
 """
-from . import (bake_operator, cli_command, panels, preferences, properties, render_operator, sphere_operators,
-               view_properties, viewport_overlay)
+from . import (auto_rebake, bake_operator, cli_command, panels, preferences, properties, render_operator,
+               sphere_operators, view_properties, viewport_overlay)
 
-_modules = (properties, view_properties, bake_operator, render_operator, sphere_operators, viewport_overlay, panels,
-            preferences, cli_command)
+_modules = (properties, view_properties, bake_operator, auto_rebake, render_operator, sphere_operators, viewport_overlay,
+            panels, preferences, cli_command)
 
 
 def register() -> None:

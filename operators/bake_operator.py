@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import time
 import traceback
+from dataclasses import replace
 
 import bpy
 
@@ -13,6 +14,7 @@ from ..hao_addon.blender.color_attributes import AO_ATTRIBUTE
 from ..hao_addon.core.errors import UserInputError
 from ..hao_addon.gpu.context import GPUUnavailableError
 from ..hao_addon.gpu.shaders import ShaderCompileError
+from ..hao_addon.rebake import RebakeReport
 
 # Errors a user can act on: the project's own types (and the file system's): reported in one
 # line. Anything else is a bug: reported as an internal error, its traceback printed to
@@ -102,6 +104,18 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
     _runner: ModalBakeRunner | None = None
     _timer = None
 
+    changed_only: bpy.props.BoolProperty(
+        name="Re-bake Changed", options={'SKIP_SAVE'},
+        description="Re-bake only the texels that what changed since the last bake of each map can have moved; "
+                    "the report gives how many, why, and the bound on the kept ones")
+
+    @classmethod
+    def description(cls, context, properties):
+        if properties.changed_only:
+            return ("Re-bake only the texels that an edit since the last bake can have changed (the others are "
+                    "kept, within the bound the report gives)")
+        return cls.__doc__
+
     @classmethod
     def poll(cls, context):
         if context.mode != 'OBJECT':
@@ -117,6 +131,8 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
 
     def _make_job(self, context) -> BakeJob:
         request = context.scene.hao_bake.to_request(bake_targets(context), context.active_object)
+        if self.changed_only:
+            request = replace(request, options=replace(request.options, rebake_changed=True))
         return BakeJob(request, context.evaluated_depsgraph_get)
 
     def _report_done(self, job: BakeJob) -> None:
@@ -130,6 +146,9 @@ class OBJECT_OT_hao_bake_ao(bpy.types.Operator):
         for _obj, _uv, result in job.results:
             for warning in result.stats.get("warnings", []):
                 self.report({'WARNING'}, warning)
+        for label, (_path, result, _state) in job.records.items():  # Re-bake Changed: what it did
+            if "rebake" in result.stats:
+                self.report({'INFO'}, f"'{label}' {RebakeReport(**result.stats['rebake']).text()}")
         if job.request.frames:
             files = sum(len(v) for k, v in job.files.items() if k[1] == "ao")
             self.report({'INFO'}, f"Baked AO of {len(job.request.frames)} frames into {files} files "

@@ -53,7 +53,10 @@ class VIEW3D_PT_hao_bake(bpy.types.Panel):
 
     def draw(self, context):
         settings = context.scene.hao_bake
-        self.layout.operator("object.hao_bake_ao", icon='RENDER_STILL')
+        row = self.layout.row(align=True)
+        row.operator("object.hao_bake_ao", icon='RENDER_STILL')
+        row.operator("object.hao_bake_ao", text="Re-bake Changed", icon='FILE_REFRESH').changed_only = True
+        self.layout.prop(settings, "auto_rebake")
         col = _split_layout(self.layout)
         col.prop(settings, "target")
         for name in target_kind(settings.to_settings().target).settings:  # the Target's own settings (its row's)

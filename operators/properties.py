@@ -43,6 +43,11 @@ class HAO_PG_bake_settings(EnumAliases, bpy.types.PropertyGroup):
         name="Cage Object", type=bpy.types.Object, poll=lambda _self, obj: obj.type == 'MESH',
         description="Selected to Active: rays start on this copy of the active mesh (same topology, moved "
                     "vertices) instead of the cage extrusion")
+    auto_rebake: BoolProperty(
+        name="Auto Re-bake",
+        description="After an edit of a mesh, re-bake what it changed of the maps baked in this session (Re-bake "
+                    "Changed, a second after the last edit, in Object Mode); off by default",
+        default=False)
     frame_range: BoolProperty(
         name="Frame Range",
         description="Bake every frame of the scene's frame range (Start, End, Step), one file per frame: "
@@ -90,7 +95,7 @@ class HAO_PG_bake_settings(EnumAliases, bpy.types.PropertyGroup):
                            multiply_base_color=self.multiply_base_color,
                            high_poly=high_poly, cage=cage,
                            map_paths=self.map_paths(settings),
-                           frames=self.scene_frames() if self.frame_range else None)
+                           frames=self.scene_frames() if self.frame_range else None, remember=True)
 
     def map_paths(self, settings: BakeSettings) -> dict[str, str]:
         """The Save ... To files of the maps besides the AO (core/bake/map_kinds.py) that this

@@ -92,6 +92,8 @@ def check(result, report, full):
     kept = full.covered & ~redo
     assert diff[kept].max(initial=0.0) <= report.kept_bound + 1e-5, (report, diff[kept].max())
     assert not (diff[kept] > report.threshold).any()  # no stale texel
+    if result.kept_offset is not None:  # and each within its own bound (added up over re-bakes)
+        assert (diff[full.covered] <= result.kept_offset[full.covered] + 1e-5).all()
     assert diff[full.filled].max() <= report.kept_bound + 1e-5  # margins grow from the merged values
     if report.why != "nothing changed":  # the stated error carries what the kept texels may be off by
         assert result.error.p99 >= report.kept_bound and result.error.rmse >= report.kept_bound
@@ -123,11 +125,28 @@ def test_fifty_scripted_edits_against_full_bakes(base_bake):
     assert min(partial) < 0.1 and sum(f < 0.5 for f in partial) >= 4, sorted(partial)
 
 
+def test_bounds_add_up_over_a_chain_of_rebakes(base_bake):
+    """A cell kept by two re-bakes in a row lies up to both bounds from the second scene's
+    bake: the second re-bake starts from the first's offsets (BakeResult.kept_offset), so its
+    stated bound holds against a full bake of the last scene, and no cell drifts past the
+    threshold."""
+    previous, state = base_bake
+    occluders = dict(BASE)
+    chained = 0
+    for name, offset in (("a", (0.05, 0, 0)), ("b", (0, 0.05, 0)), ("a", (0, 0.05, 0)), ("c", (0.05, 0, 0))):
+        occluders[name] = moved(occluders[name], offset)
+        previous, state, report = rebake(previous, state, plane(), list(occluders.values()), SETTINGS)
+        check(previous, report, bake(plane(), list(occluders.values()), SETTINGS, use_cache=False))
+        chained += int((previous.kept_offset > 0.0).sum() > 0)
+    assert chained == 4 and previous.kept_offset.max() < report.threshold
+
+
 def test_nothing_changed_keeps_the_map_and_a_setting_rebakes_all(base_bake):
     previous, state = base_bake
     occluders = list(BASE.values())
     same, _s, report = rebake(previous, state, plane(), occluders, SETTINGS)
-    assert same is previous and report.rebaked == 0 and report.why == "nothing changed"
+    assert same.ao is previous.ao and report.rebaked == 0 and report.why == "nothing changed"
+    assert same.stats["rebake"] == report.as_dict() and same.stats["covered_texels"] == int(previous.covered.sum())
     _r, _s, report = rebake(previous, state, plane(), occluders, replace(SETTINGS, directions=32))
     assert report.full and "setting" in report.why
     _r, _s, report = rebake(None, None, plane(), occluders, SETTINGS)
@@ -173,3 +192,27 @@ def test_large_maps_bound_by_face_pieces_and_hold_it(base_bake, monkeypatch):
         target = plane(bumps)
         result, _state, report = rebake(previous, state, target, list(occluders.values()), settings)
         check(result, report, bake(target, list(occluders.values()), settings, use_cache=False))
+
+
+def test_gather_cells_equal_the_whole_bake_and_draw_only_their_window(gpu_context):
+    """The GPU gather bakes a subset of texels (abilities.bakes_all_cells is ''): each cell
+    gets the whole bake's value bit for bit (its depth maps are the whole bake's, cropped to
+    the window of the cells' faces; its list entries the whole raster's), and its light
+    views hold a share of the whole bake's pixels (the counter view_pixels)."""
+    from hao_addon.bake import bake_cells_steps
+    from hao_addon.core.steps import drain
+    settings = BakeSettings(size=256, directions=32, method="gather")
+    floor = scenes.grid_plane(20.0, 32)
+    target = TriangleSoup(floor.positions, floor.uvs, "floor")
+    occluders = [ball(f"b{i}", (x, y, 0.5), 0.5) for i, (x, y) in enumerate([(-4, -4), (4, 4), (3.0, -2.0)])]
+    whole = bake(target, occluders, settings, use_cache=False)
+    ys, xs = np.mgrid[0:settings.size, 0:settings.size]
+    compact = np.flatnonzero((np.abs(xs - 179) < 20) & (np.abs(ys - 179) < 20))  # about ball b1's foot
+    streak = np.flatnonzero(np.abs(xs - ys - 40) < 2)  # a diagonal line across the map
+    for cells in (compact, streak):
+        part = drain(bake_cells_steps(target, occluders, settings, cells))
+        assert np.array_equal(part.ao.reshape(-1)[cells], whole.ao.reshape(-1)[cells])
+        assert part.covered.reshape(-1)[cells].all() and part.covered.sum() == len(cells)
+        assert part.stats["view_pixels"] < (0.2 if cells is compact else 1.01) * whole.stats["view_pixels"]
+        assert part.stats["texel_list_entries"] == len(cells)
+

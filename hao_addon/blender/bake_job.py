@@ -26,6 +26,7 @@ from ..verify import verify_steps
 from ..core.imageio import StagedFiles
 from ..core.output_files import check_output_files
 from ..core.bake.projection import HighToLow
+from ..core.bake.scene_changes import SceneState
 from ..core.bake.settings import BakeSettings
 from ..core.bake.map_kinds import EXTRA_MAPS
 from ..core.bake.targets import BakeTarget
@@ -35,6 +36,8 @@ from . import color_attributes, images, mesh_data
 from .bake_request import (TEXTURE_SET_NAME, BakeGroup, BakeRequest, input_files, output_kinds, output_path_for,
                            planned_files, terminator_settings, tile_paths, validate_request)
 from .map_producers import bent_normal_image, orm_map, surface_maps
+from .rebake_records import keeps_records, recorded_steps, remember_records, stage_records
+from .job_summary import job_summary
 from .view_scene import BAKED_AO_PROPERTY
 
 @dataclass
@@ -80,6 +83,9 @@ class BakeJob:
         self._frame_bakes: dict[tuple[str, str], tuple[int, dict, tuple | None]] = {}
         self._copies: dict[str, int] = {}  # this frame's labels -> the earlier frame to copy
         self.committed: list[bpy.types.Image] = []
+        # Each label's (map path, bake, scene state) for Re-bake Changed (_recorded_steps):
+        # remembered or written beside the map at commit.
+        self.records: dict[str, tuple[str, BakeResult, SceneState]] = {}
         self.finished = False
         self.unwrap_seconds = 0.0
 
@@ -246,9 +252,11 @@ class BakeJob:
                 return
         # A sequence bakes past the shared cache: it would hold up to its size in maps.
         # (relay closes it on cancel: bake_steps' finally frees the GPU pass now.)
-        result = yield from relay(bake_steps(target, occluders, settings, use_cache=frame is None),
-                                  lambda frac: (start + share * frac,
-                                                f"Baking AO of '{label}'{at} {count}: {frac * 100:.0f}%"))
+        steps = bake_steps(target, occluders, settings, use_cache=frame is None)
+        if keeps_records(self.request, frame):  # re-bakes only what changed, or keeps its state for that
+            steps = recorded_steps(self.request, unit, target, occluders, settings, self.records)
+        result = yield from relay(steps, lambda frac: (start + share * frac,
+                                                       f"Baking AO of '{label}'{at} {count}: {frac * 100:.0f}%"))
         result = yield from self._verified(result, target, occluders, settings, label, start + share, at)
         yield from self._make_maps(unit, uv_names, depsgraph, soup, settings, result, start + share, frame)
         if alpha_notes:
@@ -342,6 +350,7 @@ class BakeJob:
             self._staged = staged
         else:
             staged.release()
+        remember_records(req, self.records)
         return self.committed
 
     def written_note(self) -> str:
@@ -391,6 +400,7 @@ class BakeJob:
                             staged.write_image(file_path, tile_map, req.file_text, req.options.png_bit_depth,
                                                req.options.dither)
                     self.files.setdefault((label, kind), []).extend(paths)
+            stage_records(staged, req, self.records)
         except BaseException:
             staged.discard()
             raise
@@ -445,23 +455,8 @@ class BakeJob:
                     images.wire_orm(obj, extra[self.label_of(obj), "orm"], uv_name)
 
     def summary(self) -> list[dict]:
-        """One entry per baked object of the last bake (the --json report's objects): its
-        triangles, UV map (and whether the job made it), covered texels, the method, shaded
-        corners, and where they apply missed texels (Selected to Active), UDIM tiles, the
-        texture set it joined; its estimated error (core/bake/error_estimate.py: rmse, p99,
-        directions, capped; None with a single direction)."""
-        out = []
-        for obj, uv_name, result in self.results:
-            st = self.own_stats.get(obj.name, result.stats)
-            out.append(dict(name=obj.name, triangles=st["target_faces"], uv_map=uv_name,
-                            uv_map_created=any(n == uv_name for _m, n in self.created_uv),
-                            covered_texels=st["covered_texels"], method=st["method"],
-                            smooth_corners=st["smooth_corners"],
-                            **({"texture_set": True} if self.request.options.texture_set else {}),
-                            **({"missed_texels": st["missed_texels"]} if "missed_texels" in st else {}),
-                            **({"udim_tiles": list(result.tiles)} if result.tiles else {}),
-                            error=st.get("error"), **({"verify": st["verify"]} if "verify" in st else {})))
-        return out
+        """One entry per baked object of the last bake (the --json report's objects: job_summary.py)."""
+        return job_summary(self)
 
     def label_of(self, obj) -> str:
         """The name a target's outputs carry: its own, or the texture set's."""

@@ -94,6 +94,9 @@ class BakeRequest:
     # Text entries every image file of the run carries (core/imageio.py's BAKE_KEY: what made
     # it, for --skip-existing).
     file_text: dict = field(default_factory=dict)
+    # Keep each map's bake in this session's memory for a later Re-bake Changed (the panel's
+    # bakes; blender/rebake_records.py).
+    remember: bool = False
 
     @property
     def kind(self) -> TargetKind:

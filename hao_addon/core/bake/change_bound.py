@@ -74,13 +74,16 @@ def change_bound(points: np.ndarray, spheres: np.ndarray, weighting: str = "cosi
 def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.ndarray, directions: np.ndarray,
                          weighting: str = "cosine", spread_angle: float = 90.0, max_distance: float = 0.0,
                          reach: np.ndarray | None = None) -> np.ndarray:
-    """(n,) float64: the most a bake's own estimate (sum of V w over its directions / sum of w)
-    can change at each receiver: the weight share of its directions (D, 3) that point into a
-    changed sphere. The estimate of finitely many directions is not bounded by change_bound's
-    share of the whole hemisphere (a direction that falls into a small cone moves it by about
-    1 / D); kept texels are held to both. normals: (n, 3) the receivers' shading normals, or
-    (n, m, 3) several each (a face's corners: each direction weighs its most over them, the
-    total its least); reach: as change_bound's."""
+    """(n,) float64: the most a bake's own estimate can change at each receiver: the weight
+    share of its directions (D, 3) that point into a changed sphere. The estimate is the mean
+    over its replicates (core/directions.replicate_sizes: consecutive runs of the directions)
+    of sum(V w) / sum(w) over the replicate's directions (estimators.texel_sums), so a
+    direction weighs w / (replicates x its replicate's sum of w). The estimate of finitely
+    many directions is not bounded by change_bound's share of the whole hemisphere (a
+    direction that falls into a small cone moves it by about 1 / D). normals: (n, 3) the
+    receivers' shading normals, or (n, m, 3) several each (a face's corners: each direction
+    weighs its most over them, each sum its least); reach: as change_bound's."""
+    from ..directions import replicate_sizes
     from .normalization import hemisphere_weight
 
     points = np.asarray(points, np.float64).reshape(-1, 3)
@@ -89,6 +92,8 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
     spheres = np.asarray(spheres, np.float64).reshape(-1, 4)
     directions = np.asarray(directions, np.float64).reshape(-1, 3)
     spread_cos = 0.0 if spread_angle >= 90.0 else float(np.cos(np.radians(spread_angle)))
+    sizes = np.cumsum([0, *replicate_sizes(len(directions))])
+    runs = list(zip(sizes[:-1], sizes[1:]))  # each replicate's directions
     if normals.shape[1] > 1 and (normals == normals[:, :1]).all():
         normals = normals[:, :1]  # flat faces: one normal does for every corner
     bound = np.zeros(len(points))
@@ -111,8 +116,11 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
         # Only receivers with a direction into a sphere weigh their directions (most do not).
         hit = np.flatnonzero(inside.any(axis=1))
         weights = hemisphere_weight(normals[start + hit] @ directions.T, weighting, spread_cos)  # (h, m, D)
-        total = np.maximum(weights.sum(axis=2).min(axis=1), 1e-300)
-        share = (weights.max(axis=1) * inside[hit]).sum(axis=1) / total
+        hits = weights.max(axis=1) * inside[hit]
+        share = np.zeros(len(hit))
+        for first, end in runs:
+            total = np.maximum(weights[..., first:end].sum(axis=2).min(axis=1), 1e-300)
+            share += hits[:, first:end].sum(axis=1) / (total * len(runs))
         bound[start + hit] = np.minimum(share, 1.0)
     return bound
 

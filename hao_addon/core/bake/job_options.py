@@ -81,6 +81,15 @@ class JobOptions:
         description="with Verify Texels: the run fails (exit 1) when the verification's 95 % interval puts the "
                     "map's p99 error above this; the maps are written either way; 0 = no bound")
 
+    rebake_changed: bool = setting(
+        False, label="Re-bake Changed",
+        description="re-bake only the texels that what changed since the last bake of the same map (recorded "
+                    "beside it, <map>.hao-rebake.npz) can have moved by half its stated error or more; the others "
+                    "are kept, and the report gives how many were re-baked, why, and the bound on the kept ones. "
+                    "A changed setting, UV layout or target face count, a bake to an error, bent normals, UDIM "
+                    "tiles, colour attributes, Selected to Active and the histogram scatter re-bake in full "
+                    "(and say so)")
+
     @property
     def png_bit_depth(self) -> int:
         return int(self.png_bits)
@@ -90,6 +99,9 @@ class JobOptions:
         validate(self)
         if self.verify_max_error > 0.0 and self.verify == 0:
             raise SettingError("verify_max_error", "verify max error checks a verification: add --verify N (texels)")
+        if self.rebake_changed and self.verify:
+            raise SettingError("rebake_changed", "re-bake changed keeps texels from the last bake: verify it "
+                                                 "with a bake of its own (drop --verify)")
         if self.dither and self.png_bits != "8":
             raise SettingError("dither", "dither applies to 8-bit PNG files: add --png-bits 8")
         if self.match_names and (not self.low_suffix or not self.high_suffix
