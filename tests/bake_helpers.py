@@ -11,6 +11,8 @@ the bias bound for every D >= 64; a visibility bug fails the RMSE bound.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from hao_addon.core.bake.uv_raster import interior_mask, texel_surface_samples
@@ -53,3 +55,18 @@ def load_image_rgba(path) -> np.ndarray:
     image.pixels.foreach_get(px)
     bpy.data.images.remove(image)
     return px.reshape(h, w, 4)
+
+
+def write_obj(path: Path, objects: dict) -> None:
+    """A Wavefront file of named triangle soups (UVs where a soup has them)."""
+    lines, base = [], 1
+    for name, soup in objects.items():
+        lines.append(f"o {name}\n")
+        lines += [f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in soup.positions.reshape(-1, 3)]
+        if soup.uvs is not None:
+            lines += [f"vt {u:.9g} {v:.9g}\n" for u, v in soup.uvs.reshape(-1, 2)]
+        for f in range(soup.face_count):
+            idx = [base + 3 * f + k for k in range(3)]
+            lines.append("f " + " ".join(f"{i}/{i}" if soup.uvs is not None else str(i) for i in idx) + "\n")
+        base += 3 * soup.face_count
+    path.write_text("".join(lines))

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bake_helpers import write_obj
 from conftest import ROOT, cli_env, run_hao
 
 SPOT = ROOT / "samples" / "spot.obj"
@@ -367,21 +368,6 @@ def test_an_error_after_a_swallowed_signal_is_that_signal(signum, code):
     finally:
         cli_io._PENDING.clear()
     assert got == code and message.endswith("nothing was written"), message
-
-
-def write_obj(path: Path, objects: dict) -> None:
-    """A Wavefront file of named triangle soups (UVs where a soup has them)."""
-    lines, base = [], 1
-    for name, soup in objects.items():
-        lines.append(f"o {name}\n")
-        lines += [f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in soup.positions.reshape(-1, 3)]
-        if soup.uvs is not None:
-            lines += [f"vt {u:.9g} {v:.9g}\n" for u, v in soup.uvs.reshape(-1, 2)]
-        for f in range(soup.face_count):
-            idx = [base + 3 * f + k for k in range(3)]
-            lines.append("f " + " ".join(f"{i}/{i}" if soup.uvs is not None else str(i) for i in idx) + "\n")
-        base += 3 * soup.face_count
-    path.write_text("".join(lines))
 
 
 def test_high_poly_from_a_file_or_by_name(dirs):

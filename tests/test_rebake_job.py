@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 import bpy
-from bake_helpers import load_image_rgba
+from bake_helpers import load_image_rgba, write_obj
 from conftest import run_hao, select_only, soup_to_object
 from hao_addon.core import scenes
 from hao_addon.rebake import record_path
@@ -28,21 +28,6 @@ def floor_and_ball(shift: float = 0.0):
     return floor, ball
 
 
-def write_obj(path: Path, soups) -> None:
-    """The soups as an .obj, each its own object (unwelded corners, UVs where it has them)."""
-    lines, base = [], 1
-    for soup in soups:
-        lines.append(f"o {soup.name}")
-        lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in soup.positions.reshape(-1, 3)]
-        if soup.uvs is not None:
-            lines += [f"vt {u:.9g} {v:.9g}" for u, v in soup.uvs.reshape(-1, 2)]
-        for f in range(soup.face_count):
-            k = [base + 3 * f + c for c in range(3)]
-            lines.append("f " + " ".join(f"{i}/{i}" if soup.uvs is not None else str(i) for i in k))
-        base += 3 * soup.face_count
-    path.write_text("\n".join(lines) + "\n")
-
-
 def bake_cli(tmp: Path, source: Path, out: Path, *extra) -> dict:
     done = run_hao(["bake", source, "--out", out, *BAKE, *extra], cwd=tmp)
     assert done.returncode == 0, done.stderr[-2000:]
@@ -55,11 +40,11 @@ def gray(path: Path) -> np.ndarray:
 
 def test_cli_rebakes_what_changed_against_the_file_and_its_record(tmp_path):
     source, out, full_out = tmp_path / "scene.obj", tmp_path / "ao.exr", tmp_path / "full.exr"
-    write_obj(source, floor_and_ball())
+    write_obj(source, {s.name: s for s in floor_and_ball()})
     first = bake_cli(tmp_path, source, out, "--rebake-changed")["objects"][0]["rebake"]
     assert first["full"] and first["why"] == "no earlier bake of this target"
     assert Path(record_path(str(out))).is_file()
-    write_obj(source, floor_and_ball(shift=0.1))  # the ball nudged
+    write_obj(source, {s.name: s for s in floor_and_ball(shift=0.1)})  # the ball nudged
     report = bake_cli(tmp_path, source, out, "--rebake-changed")
     rebake = report["objects"][0]["rebake"]
     assert not rebake["full"] and 0 < rebake["rebaked"] < rebake["covered"]

@@ -53,6 +53,7 @@ BENCHES = [("bake_bench", "Bake: time against error, beside Cycles"),
            ("groups_bench", "Bake groups matched by name"),
            ("alpha_bench", "Alpha-aware occluders"),
            ("list_forms_bench", "Lists as textures or storage buffers (Blender 5.3)"),
+           ("rebake_bench", "Re-bake Changed against a whole bake"),
            ("regression_bench", "Same-run regression check")]
 
 
@@ -236,11 +237,24 @@ def readme_numbers() -> str:
     lines.append(f"- **Auto-unwrap**: the 69,451-triangle bunny without UVs unwraps in {new['seconds']:.1f} s at 256² "
                  f"(xatlas alone: {old['seconds']:.1f} s), covering {new['coverage']:.2f} of the texels "
                  f"(xatlas: {old['coverage']:.2f}), no overlaps ([report](docs/benchmarks.md#auto-unwrap)).")
+    rows = _load("rebake_bench")["rows"]
+    spans = ", ".join(f"{100 * r['rebaked_share']:.2g} % in {r['incremental_s']:.1f} s against {r['full_s']:.1f} s "
+                      f"({r['speedup']:.1f}x)" for r in rows if r["size"] == max(x["size"] for x in rows))
+    lines.append(f"- **Re-bake Changed**: after moving one ball of a scene, re-baking only the texels it can have "
+                 f"changed at {max(r['size'] for r in rows)}²: {spans}; "
+                 f"{held(rows)} ([report](docs/benchmarks.md#re-bake-changed-against-a-whole-bake)).")
     farm = _load("farm_bench")
     lines.append(f"- **Farms**: {farm['inputs']} inputs as one farm task cost {farm['ratio_one_task_to_local_batch']:.2f}x "
                  f"one local batch; a bundle of {farm['bundle_inputs']:,} inputs is written in "
                  f"{farm['bundle_seconds']:.1f} s ([report](docs/benchmarks.md#farm-tasks)).")
     return "\n".join(lines)
+
+
+def held(rows: list[dict]) -> str:
+    """Whether every kept texel of the re-bake benchmark lay within its report's bound."""
+    if all(r["kept_max_difference"] <= r["kept_bound"] + 1e-6 and r["rebaked_max_difference"] == 0.0 for r in rows):
+        return "every kept texel within the stated bound of a whole bake, every re-baked one equal to it"
+    return "NOT every texel within the stated bound of a whole bake: see the report"
 
 
 def _cores(result: dict) -> str:
