@@ -256,13 +256,13 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
                                                (sums_b if sums_a is None else sums_a, sums_b))
     finally:
         baker.free()
-    # A run of some cells grows no margins: whoever merges it grows them from the merged
-    # values (_combine_rounds, rebake.py), and at 2048^2 they cost 0.4 s of a 1 % re-bake.
-    margin = settings.margin if plan.cells is None else 0
-    ao, covered, filled, bent = plan.layout.finished(plan.estimator, sums, margin)
-    twin = None if sums_a is None else replicate_twin(*plan.estimator.ratio(sums_a), *plan.estimator.ratio(sums_b))
-    if twin is not None:
-        twin = np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
+    # A run of some cells grows no margins and is finished at its cells alone: whoever merges
+    # it grows them from the merged values (_combine_rounds, rebake.py).
+    if plan.cells is None:
+        ao, covered, filled, bent = plan.layout.finished(plan.estimator, sums, settings.margin)
+    else:
+        ao, covered, filled, bent = plan.layout.finished_cells(plan.estimator, sums, plan.cells)
+    twin = None if sums_a is None else _twin(plan, sums_a, sums_b, covered)
     error = None if twin is None else estimate(twin, covered, count)
     if not covered.any() and not plan.layout.per_element:
         # A map of no texel is not a bake: a success here would hand back an empty image.
@@ -272,6 +272,20 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
              "cache_hit": False, "error": None if error is None else error.as_dict()}
     return BakeResult(ao, covered, filled, stats, bent, plan.layout.tiles, twin, error, method)
+
+
+def _twin(plan, sums_a: np.ndarray, sums_b: np.ndarray, covered: np.ndarray) -> np.ndarray:
+    """(covered's shape) float32 each covered cell's twin (replicate_twin), 0 elsewhere; a run
+    of some cells computes it at them alone."""
+    ratio = plan.estimator.ratio
+    if plan.cells is None or covered.size != np.prod(plan.layout.output_shape):
+        twin = replicate_twin(*ratio(sums_a), *ratio(sums_b))
+        return np.where(covered, twin.reshape(covered.shape), np.float32(0.0))
+    cells = plan.cells
+    parts = [part.reshape(-1)[cells] for part in (*ratio(sums_a), *ratio(sums_b))]
+    twin = np.zeros(covered.shape, np.float32)
+    twin.reshape(-1)[cells] = replicate_twin(*parts)
+    return np.where(covered, twin, np.float32(0.0))
 
 
 def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: BakeSettings, first_run: BakeRun,

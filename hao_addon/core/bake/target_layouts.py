@@ -139,6 +139,23 @@ class TexelLayout:
             return ao[0], covered[0], filled[0], None if bent is None else bent[0]
         return ao, covered, filled, bent
 
+    def finished_cells(self, estimator: Estimator, sums: np.ndarray, cells: np.ndarray) -> Finished:
+        """finished() of a run of some cells (flat indices), margin 0, computed at the cells
+        alone: the same values at its covered cells (the only ones a merge takes: rebake.py,
+        bake._combine_rounds), the rest background and not covered (the whole map's ratio,
+        erosion and rim cost 0.5 s of a 1 % re-bake at 2048^2). UDIM tiles and bent normals
+        take the whole map's path."""
+        if self.udim is not None or estimator is BENT_NORMALS:
+            return self.finished(estimator, sums, 0)
+        numerator, weight = (part.reshape(-1)[cells] for part in estimator.ratio(sums))
+        here = estimated(weight)
+        ao = np.ones(self.output_shape, np.float32)
+        ao.reshape(-1)[cells] = np.where(here, np.clip(np.divide(numerator, weight, out=np.zeros_like(numerator),
+                                                                 where=here), 0.0, 1.0), 1.0)
+        covered = np.zeros(self.output_shape, bool)
+        covered.reshape(-1)[cells] = here
+        return ao, covered, covered.copy(), None
+
     def estimated(self, weight: np.ndarray) -> np.ndarray:
         """The cells whose value is the bake's own estimate, by their summed weight."""
         return estimated(weight, elements=self.per_element)
@@ -242,6 +259,9 @@ class CornerLayout(TexelLayout):
     def finished(self, estimator: Estimator, sums: np.ndarray, margin: int) -> Finished:
         """One value per element (element_values), no bent normals."""
         return (*element_values(*estimator.ratio(sums)), None)
+
+    def finished_cells(self, estimator: Estimator, sums: np.ndarray, cells: np.ndarray) -> Finished:
+        return self.finished(estimator, sums, 0)
 
 
 LAYOUTS: dict[str, type[TexelLayout]] = {layout.KIND: layout for layout in (TexelLayout, ProjectedLayout, CornerLayout)}
