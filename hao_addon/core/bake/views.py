@@ -29,9 +29,9 @@ class OrthoView:
     depth_near: float
     depth_far: float
     # A view cropped from a whole one (a run of some texels, fit_views' window_points): that
-    # view, and the whole view's pixel where this one's first pixel lies. A test of a receiver
-    # against the cropped depth map reads it through the whole view's matrix (the same pixel
-    # and depth arithmetic as the whole bake's), offset by `first`.
+    # view, and the whole view's pixel where the window of width x height pixels starts. Its
+    # depth map is the whole view's, drawn in the window alone and read through the whole
+    # view's matrix (the same pixel and depth arithmetic as the whole bake's).
     whole: "OrthoView | None" = None
     first: tuple[int, int] = (0, 0)
 
@@ -121,8 +121,8 @@ def _view_from_extent(basis: np.ndarray, lo_all: np.ndarray, hi_all: np.ndarray,
     size = np.array([width, height])
     first = np.clip(np.floor((crop[0][:2] - pixel_size - lo) / pixel_size), 0, size - 1).astype(int)
     end = np.clip(np.ceil((crop[1][:2] + pixel_size - lo) / pixel_size), first + 1, size).astype(int)
-    view = _ortho_view(basis, lo + first * pixel_size, end - first, pixel_size, zlo - pad, zhi + pad)
-    return replace(view, whole=whole, first=(int(first[0]), int(first[1])))
+    return replace(whole, width=int(end[0] - first[0]), height=int(end[1] - first[1]), whole=whole,
+                   first=(int(first[0]), int(first[1])))
 
 
 def _ortho_view(basis: np.ndarray, lo: np.ndarray, size, pixel_size: float, zlo: float, zhi: float) -> OrthoView:
