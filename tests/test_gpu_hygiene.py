@@ -57,7 +57,7 @@ def test_every_shader_variant_compiles(gpu_context):
 
 def test_registration_needs_no_gpu_and_is_symmetric(addon):
     import bpy
-    from hao_ext.operators import cli_command, sphere_operators, viewport_overlay
+    from hao_ext.operators import auto_rebake, cli_command, sphere_operators, viewport_overlay
     from hao_ext.operators.properties import HAO_PG_bake_settings
     names = ("OBJECT_OT_hao_bake_ao", "VIEW3D_PT_hao_bake", "RENDER_OT_hao_render_ao", "VIEW3D_PT_hao_view",
              "OBJECT_OT_hao_sync_spheres", "OBJECT_OT_hao_clear_spheres")
@@ -73,7 +73,10 @@ def test_registration_needs_no_gpu_and_is_symmetric(addon):
     assert cli_command._handle is None and viewport_overlay._draw_handle is None
     assert sphere_operators._draw_handle is None
     assert sphere_operators.sync_on_frame_change not in bpy.app.handlers.frame_change_post
-    assert [len(h) for h in handler_lists] == [counts[0] - 1, counts[1] - 2, counts[2] - 1]
+    assert auto_rebake.note_edit not in bpy.app.handlers.depsgraph_update_post
+    assert not bpy.app.timers.is_registered(auto_rebake.run_auto_rebake)
+    # depsgraph updates: the viewport overlay's and Auto Re-bake's handlers
+    assert [len(h) for h in handler_lists] == [counts[0] - 2, counts[1] - 2, counts[2] - 1]
     addon.register()
     assert hasattr(bpy.types.Scene, "hao_bake") and all(hasattr(bpy.types, n) for n in names)
     assert [len(h) for h in handler_lists] == counts

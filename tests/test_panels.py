@@ -34,6 +34,7 @@ class RecordingLayout:
 
     def operator(self, idname, **_kw):
         self.log.append(("op", idname))
+        return SimpleNamespace()  # the operator's properties, as Blender returns them
 
     def label(self, text="", **_kw):
         self.log.append(("label", text))

@@ -18,7 +18,6 @@ from ..core.bake.target_kinds import target_kind
 from ..core.frame_ranges import parse_frames
 from ..core.output_files import check_output_files, FRAME_TOKEN, INPUT_TOKEN, OBJECT_TOKEN
 from ..core.setting_spec import SettingError
-from ..rebake import RebakeReport
 
 
 GLTF_OUT = "the glTF file (--gltf-out)"  # its name in collision messages
@@ -295,6 +294,7 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
         lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {error}{frames} in "
                      f"{seconds:.2f} s -> {dest}")
         if "rebake" in st:  # --rebake-changed: what it re-baked, and the bound on what it kept
+            from ..rebake import RebakeReport
             lines.append(f"hao: '{label}' {RebakeReport(**st['rebake']).text()}")
     bound = run.options.verify_max_error
     for label, check in job.verifications:

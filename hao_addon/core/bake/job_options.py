@@ -82,8 +82,8 @@ class JobOptions:
                     "map's p99 error above this; the maps are written either way; 0 = no bound")
 
     rebake_changed: bool = setting(
-        False, label="Re-bake Changed",
-        description="re-bake only the texels that what changed since the last bake of the same map (recorded "
+        False, label="Re-bake Changed", ui=False,  # the panel's own button sets it for its run
+        description="(in the panel: the Re-bake Changed button beside Bake AO) re-bake only the texels that what changed since the last bake of the same map (recorded "
                     "beside it, <map>.hao-rebake.npz) can have moved by half its stated error or more; the others "
                     "are kept, and the report gives how many were re-baked, why, and the bound on the kept ones. "
                     "A changed setting, UV layout or target face count, a bake to an error, bent normals, UDIM "
