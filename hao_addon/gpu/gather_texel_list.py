@@ -26,9 +26,11 @@ def entry_bytes(plan: BakePlan) -> int:
 
 
 def faces_reaching_cells(plan: BakePlan) -> BakePlan:
-    """plan with the target's faces that reach its cells alone (receivers.faces_touching): the
-    texel list of a run of some cells rasterizes only them."""
-    faces = faces_touching(plan.target_uvs, plan.settings.size, plan.cells)
+    """plan with the target's faces that reach its cells alone (the plan's window_faces,
+    receivers.faces_touching): the texel list of a run of some cells rasterizes only them."""
+    faces = plan.window_faces
+    if faces is None:  # a run whose cells no face reaches
+        faces = faces_touching(plan.target_uvs, plan.settings.size, plan.cells)
     return replace(plan, target_positions=plan.target_positions[faces], target_uvs=plan.target_uvs[faces],
                    target_faces=plan.target_faces[faces], target_corners=plan.target_corners[faces],
                    target_above=plan.target_above[faces])

@@ -151,8 +151,7 @@ def face_box_bounds(uvs: np.ndarray, bound: np.ndarray, size: int, grid: int) ->
     return coarse.reshape(grid, grid)[rows[:, None], rows[None, :]]
 
 
-# Pieces a bound is computed over, at most (face_pieces, refined_piece_bounds): a few hundred
-# MB of arrays.
+# Pieces a bound is computed over, at most (refined_piece_bounds): a few hundred MB of arrays.
 MAX_PIECES = 1 << 21
 
 
@@ -167,27 +166,6 @@ def _subdivision(level: int) -> np.ndarray:
                 out.append([(i + 1, j), (i + 1, j + 1), (i, j + 1)])
     ij = np.asarray(out, np.float64) / level  # (level^2, 3, 2): (u, v) weights of corners 1, 2
     return np.concatenate([1.0 - ij.sum(axis=2, keepdims=True), ij], axis=2)
-
-
-def face_pieces(*per_corner: np.ndarray, radius: float) -> list[np.ndarray]:
-    """The faces of per_corner arrays (each (F, 3, ...): world corners first, then UVs,
-    normals) cut into pieces no wider than about radius (each face into level^2 triangles,
-    level up to 32 and MAX_PIECES in all): a large face of a low-poly target would otherwise
-    stand for all its receivers with one wide sphere."""
-    world = per_corner[0]
-    centre = 0.5 * (world.min(axis=1) + world.max(axis=1))
-    reach = np.linalg.norm(world - centre[:, None], axis=2).max(axis=1)
-    level = np.clip(np.ceil(reach / max(radius, 1e-300)), 1, 32).astype(np.int64)
-    while (level ** 2).sum() > MAX_PIECES and level.max() > 1:
-        level = np.maximum(1, level // 2)
-    parts: list[list[np.ndarray]] = [[] for _ in per_corner]
-    for lv in np.unique(level):
-        faces = np.flatnonzero(level == lv)
-        bary = _subdivision(int(lv))  # (P, 3, 3)
-        for k, array in enumerate(per_corner):
-            pieces = np.einsum("pck,fk...->fpc...", bary, array[faces])
-            parts[k].append(pieces.reshape(-1, *array.shape[1:]))
-    return [np.concatenate(p) for p in parts]
 
 
 def quartered(*per_corner: np.ndarray) -> list[np.ndarray]:

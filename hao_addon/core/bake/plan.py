@@ -67,8 +67,11 @@ class BakePlan:
     max_view_side: int
     target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
     drawn_sphere: tuple[np.ndarray, float]  # normalized bounding sphere of everything drawn
-    # (m, 3) float64 normalized, or None: a run of some cells crops each view to these points
-    # (views.fit_views: the whole bake's pixel grid and depth range).
+    # A run of some cells (of a baker that bakes a subset): the target's faces that reach them
+    # (k,) (receivers.faces_touching), and their corners (3k, 3) float64 normalized that each
+    # view is cropped to (views.fit_views: the whole bake's pixel grid and depth range); None:
+    # the whole views.
+    window_faces: np.ndarray | None = None
     window_points: np.ndarray | None = None
     needs_footprint_splat: bool = False
     # Some corner's shading normal differs from its face normal: the passes then weight by
@@ -221,18 +224,18 @@ class BakePlan:
                          self.window_points)
 
 
-def _window_corners(t_pos: np.ndarray, target, settings: BakeSettings, run: BakeRun,
-                    layout: TexelLayout, method: str) -> np.ndarray | None:
-    """(n, 3) normalized corners a run of some texels of one UV tile (an incremental re-bake's
-    cells) crops its light views to: those of the faces that reach them. Each view then
-    covers only their part of the whole bake's view (a ray from a receiver stays inside its
-    window), and costs that part's pixels. None: the whole views (and for a baker that bakes
-    every texel, abilities.bakes_all_cells)."""
+def _window_faces(target, settings: BakeSettings, run: BakeRun, layout: TexelLayout, method: str
+                  ) -> np.ndarray | None:
+    """(k,) the faces that reach a run of some texels of one UV tile (an incremental re-bake's
+    cells): its light views are cropped to their corners, each then covering only their part
+    of the whole bake's view (a ray from a receiver stays inside its window) and costing that
+    part's pixels. None: the whole views (and for a baker that bakes every texel,
+    abilities.bakes_all_cells)."""
     if (run.cells is None or declaration(method).bakes_all_cells or layout.KIND != TexelLayout.KIND
             or layout.udim is not None or target.uvs is None):
         return None
     faces = faces_touching(target.uvs, settings.size, run.cells)
-    return t_pos[faces].reshape(-1, 3) if len(faces) else None
+    return faces if len(faces) else None
 
 
 # The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets
@@ -316,7 +319,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
     # A view's side is at most the diameter of the whole target (extent about the origin); a
     # run of some cells draws a window of such views (views.fit_views).
-    window = _window_corners(t_pos, target, settings, run, layout, method)
+    window = _window_faces(target, settings, run, layout, method)
     return BakePlan(
         settings=settings, run=run, layout=layout, method=method, centre=centre, scale=scale,
         target_positions=t_pos.astype(np.float32), target_uvs=uvs.astype(np.float32),
@@ -326,7 +329,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         max_view_side=int(np.ceil(2.0 * extent / pixel_size)) + 4,
         # Distinct corners: a light view's window is fitted to them (shared corners once).
         target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
-        window_points=window,
+        window_faces=window, window_points=None if window is None else t_pos[window].reshape(-1, 3),
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
         smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
         stats=stats, alpha=alpha)
