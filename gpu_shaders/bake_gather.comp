@@ -170,6 +170,14 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
 #  define TERMINATOR_VISIBLE(depth_tex, k, cos_theta, cos_true) \
     float visible = (cos_true > 0.0) ? VISIBLE(depth_tex, k, geometric) : 0.0;
 #endif
+#ifdef DIFFERENCE
+/* A re-bake by difference (hao_addon/rebake_difference.py): a view of the scene before the
+ * edit (omega.w < 0) takes its lit weight off and adds no weight, so the sums are N after
+ * minus N before, and W after (ambient occlusion's two sums alone). */
+#  define VIEW_TERM(k, term) ((views.omega[k].w < 0.0) ? vec2(-(term).x, 0.0) : (term))
+#else
+#  define VIEW_TERM(k, term) (term)
+#endif
 #ifdef SHADING_NORMALS
 #  define GATHER_VIEW(depth_tex, k) \
   { \
@@ -178,7 +186,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
       float cos_true = dot(geometric, views.omega[k].xyz); \
       TERMINATOR_VISIBLE(depth_tex, k, cos_theta, cos_true) \
-      sum += ESTIMATOR_TERM(weight, visible, views.omega[k].xyz); \
+      sum += VIEW_TERM(k, ESTIMATOR_TERM(weight, visible, views.omega[k].xyz)); \
     } \
   }
 #else
@@ -187,7 +195,7 @@ float visible_from_layers(int k, vec3 position, vec3 plane_normal, float slope_s
     float cos_theta = dot(normal, views.omega[k].xyz); \
     if (cos_theta > 0.0) { \
       float weight = VIEW_WEIGHT(cos_theta) * position.w; \
-      sum += ESTIMATOR_TERM(weight, VISIBLE(depth_tex, k, normal), views.omega[k].xyz); \
+      sum += VIEW_TERM(k, ESTIMATOR_TERM(weight, VISIBLE(depth_tex, k, normal), views.omega[k].xyz)); \
     } \
   }
 #endif

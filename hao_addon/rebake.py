@@ -36,6 +36,9 @@ from .core.bake.targets import BakeTarget
 from .core.bake.udim import udim_layout
 from .core.geometry import TriangleSoup
 from .core.steps import drain, relay
+from .rebake_difference import difference_steps, merged_by_difference
+
+DIFFERENCE = "by difference"  # RebakeReport.how of cells re-baked by rebake_difference.py
 
 # Cells whose bound is below this share of the map's stated RMSE are kept: kept cells then add
 # at most half the stated RMSE (in quadrature, the map's RMSE grows by at most 12 %), and the
@@ -46,7 +49,8 @@ KEEP_SHARE = 0.5
 @dataclass(frozen=True)
 class RebakeReport:
     """What a re-bake did: full (and why) or the cells baked again of those covered; the
-    largest bound among kept cells and the threshold they were kept under."""
+    largest bound among kept cells (and among the offsets that cells re-baked by difference
+    carry from earlier re-bakes) and the threshold they were kept under."""
 
     full: bool
     why: str
@@ -56,17 +60,20 @@ class RebakeReport:
     threshold: float = 0.0
     # The cells baked again (flat indices into the map), None for a full bake or none.
     cells: np.ndarray | None = field(default=None, compare=False, repr=False)
+    # How the cells were baked: 'by difference' (rebake_difference.py) or 'baked whole: why'.
+    how: str = ""
 
     def text(self) -> str:
         if self.full:
             return f"re-baked in full: {self.why}"
-        return (f"re-baked {self.rebaked} of {self.covered} texels ({self.why}); the {self.covered - self.rebaked} "
+        how = f", {self.how}" if self.how else ""
+        return (f"re-baked {self.rebaked} of {self.covered} texels ({self.why}{how}); the {self.covered - self.rebaked} "
                 f"kept are within {self.kept_bound:.2g} of a whole bake of the edited scene (kept below "
                 f"{self.threshold:.2g})")
 
     def as_dict(self) -> dict:
         return {"full": self.full, "why": self.why, "rebaked": self.rebaked, "covered": self.covered,
-                "kept_bound": self.kept_bound, "threshold": self.threshold}
+                "kept_bound": self.kept_bound, "threshold": self.threshold, "how": self.how}
 
 
 def settings_key(settings: BakeSettings) -> str:
@@ -136,7 +143,8 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
     threshold = KEEP_SHARE * previous.error.rmse
     # A cell kept by earlier re-bakes already lies up to their bounds from its scene's bake.
     carried = 0.0 if previous.kept_offset is None else previous.kept_offset.reshape(-1).astype(np.float64)
-    bounds = carried + _cell_bounds(plan, spheres, settings, threshold)
+    grown = _grown(plan, spheres)
+    bounds = carried + _cell_bounds(plan, grown, settings, threshold)
     redo = previous.covered.reshape(-1) & (bounds >= threshold)
     kept = previous.covered.reshape(-1) & ~redo
     kept_bound = float(bounds[kept].max()) if kept.any() else 0.0
@@ -150,8 +158,14 @@ def rebake_steps(previous: BakeResult | None, before: SceneState | None, target:
         kept = replace(previous, error=_with_bound(noise, previous.error, kept_bound), kept_offset=offset)
         return _reported(kept, stats, report), after, report
     cells = np.flatnonzero(redo)
-    part = yield from relay(bake_cells_steps(target, occluders, settings, cells), lambda f: 0.1 + 0.9 * f)
-    report = RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells)
+    part, how = yield from relay(_cells_steps(previous, before, (target, occluders), settings, cells, grown),
+                                 lambda f: 0.1 + 0.9 * f)
+    if how == DIFFERENCE and previous.kept_offset is not None:
+        # A difference adds to the earlier value: a cell keeps what earlier re-bakes let it carry
+        # (under the threshold, which it was kept under).
+        offset.reshape(-1)[cells] = carried[cells]
+        kept_bound = max(kept_bound, float(carried[cells].max()))
+    report = RebakeReport(False, why, len(cells), covered, kept_bound, threshold, cells, how)
     merged = replace(_merged(previous, part, redo.reshape(previous.covered.shape), settings, kept_bound),
                      kept_offset=offset)
     return _reported(merged, {**stats, **part.stats, "covered_texels": covered}, report), after, report
@@ -187,7 +201,32 @@ RECEIVER_BOUND_SIZE = 512
 PIECE_SHARE = 0.25
 
 
-def _cell_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: float) -> np.ndarray:
+def _grown(plan, spheres: np.ndarray) -> np.ndarray:
+    """(k, 4) the changed spheres grown by a GPU baker's slack (SLACK_PIXELS)."""
+    slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
+    return spheres + np.array([0.0, 0.0, 0.0, slack])
+
+
+def _cells_steps(previous: BakeResult, before: SceneState, after_scene: tuple, settings: BakeSettings,
+                 cells: np.ndarray, grown: np.ndarray) -> Generator[float, None, tuple[BakeResult, str]]:
+    """(the cells baked again, as a BakeResult of which only they count; how): by difference
+    where it can be measured (rebake_difference.py), else whole."""
+    found = yield from relay(difference_steps(before, settings, after_scene, cells, grown), lambda f: 0.5 * f)
+    if isinstance(found, str):
+        part = yield from relay(bake_cells_steps(*after_scene, settings, cells), lambda f: 0.5 + 0.5 * f)
+        return part, f"baked whole: {found}"
+    twin = None if previous.twin is None else previous.twin.reshape(-1)[cells]
+    values, twins = merged_by_difference(previous.ao.reshape(-1)[cells], twin, found)
+    ao, covered = np.ones(previous.ao.shape, np.float32), np.zeros(previous.covered.shape, bool)
+    ao.reshape(-1)[cells], covered.reshape(-1)[cells] = values, True
+    part_twin = None
+    if twins is not None:
+        part_twin = np.zeros(previous.ao.shape, np.float32)
+        part_twin.reshape(-1)[cells] = twins
+    return BakeResult(ao, covered, covered, found.stats, twin=part_twin, method=previous.method), DIFFERENCE
+
+
+def _cell_bounds(plan, grown: np.ndarray, settings: BakeSettings, threshold: float) -> np.ndarray:
     """(cells,) a bound on how far each output cell's value can lie from a whole bake of the
     edited scene (plan: that bake's): the weight share of the bake's own directions that
     enter a changed sphere (sampled_change_bound; the same directions, so a direction that
@@ -196,9 +235,8 @@ def _cell_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: f
     (cut finer where they reach threshold). The hemisphere's own bound (change_bound, (r /
     D)^2) is what this tends to at many directions; at few it is no bound on an estimate
     (one direction into a small cone moves it by about 1 / D), and at 128 directions on an
-    8-unit floor it would re-bake every texel for a ball of 0.4 moved by 0.1."""
-    slack = SLACK_PIXELS * plan.pixel_size * plan.scale if declaration(plan.method).gpu else 0.0
-    grown = spheres + np.array([0.0, 0.0, 0.0, slack])
+    8-unit floor it would re-bake every texel for a ball of 0.4 moved by 0.1. grown: the
+    changed spheres grown by the slack (_grown)."""
     if settings.size <= RECEIVER_BOUND_SIZE:
         return _receiver_bounds(plan, grown, settings)
     return _piece_bounds(plan, grown, settings, threshold)
@@ -287,6 +325,10 @@ def record_bytes(state: SceneState, result: BakeResult) -> bytes:
             arrays[name] = getattr(result, name)
     for k, soup in enumerate(state.soups.values()):
         arrays[f"prints{k}"], arrays[f"spheres{k}"] = soup.fingerprints, soup.spheres
+    scene = _scene_arrays(state.scene)
+    if scene is not None:
+        meta["scene"], kept = scene
+        arrays.update(kept)
     out = io.BytesIO()
     np.savez_compressed(out, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8), **arrays)
     return out.getvalue()
@@ -305,7 +347,28 @@ def read_record(data: bytes) -> tuple[BakeResult, SceneState] | None:
             optional = {name: npz[name] if name in npz.files else None for name in ("twin", "kept_offset")}
             result = BakeResult(npz["ao"], npz["covered"], npz["filled"], {"method": meta["method"]}, error=error,
                                 method=meta["method"], **optional)
+            scene = _scene_of(meta.get("scene"), npz)
     except (OSError, ValueError, KeyError, TypeError, json.JSONDecodeError):
         return None
-    return result, SceneState(meta["settings_key"], meta["target_layout"], soups)
+    return result, SceneState(meta["settings_key"], meta["target_layout"], soups, scene)
+
+
+def _scene_arrays(scene: tuple | None) -> tuple[list[str], dict] | None:
+    """(the soups' names, their arrays) of a state's scene for the record, the target first
+    (positions exact, and the target's UVs: what a re-bake by difference draws of the scene
+    before, rebake_difference.py); None without one, or where a soup lets light through
+    (which a difference cannot measure)."""
+    if scene is None or any(soup.alpha is not None for soup in [scene[0], *scene[1]]):
+        return None
+    target, occluders = scene
+    arrays = {"scene_uvs": target.uvs, **{f"scene{k}": soup.positions for k, soup in enumerate([target, *occluders])}}
+    return [soup.name for soup in [target, *occluders]], arrays
+
+
+def _scene_of(names: list[str] | None, npz) -> tuple | None:
+    """The (target, occluders) _scene_arrays kept, or None."""
+    if names is None:
+        return None
+    soups = [TriangleSoup(npz[f"scene{k}"], npz["scene_uvs"] if k == 0 else None, name) for k, name in enumerate(names)]
+    return soups[0], soups[1:]
 

@@ -48,6 +48,7 @@ def test_cli_rebakes_what_changed_against_the_file_and_its_record(tmp_path):
     report = bake_cli(tmp_path, source, out, "--rebake-changed")
     rebake = report["objects"][0]["rebake"]
     assert not rebake["full"] and 0 < rebake["rebaked"] < rebake["covered"]
+    assert rebake["how"] == "by difference"  # the record keeps the scene before the edit
     assert report["objects"][0]["error"]["rmse"] > 0.0
     bake_cli(tmp_path, source, full_out)
     diff = np.abs(gray(out) - gray(full_out))

@@ -28,7 +28,9 @@ import math
 import gpu
 import numpy as np
 
-from ..core.bake.face_chunks import face_chunks, hole_chunk_ranges_many
+from ..core.bake.entry_blocks import block_runs, intersected_runs
+from ..core.bake.face_chunks import (boxes_meeting_windows, face_chunks, hole_chunk_ranges_many,
+                                      window_chunk_ranges_many)
 from ..core.bake.normal_bins import (BIN_COUNT, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
                                      normal_bins, octahedral_decode, proximity_order)
 from ..core.directions import probe_order
@@ -37,6 +39,7 @@ from ..core.bake.plan import BakePlan
 from ..core.bake.probe_snapshot import EntrySnapshot
 from ..core.bake.receivers import Receivers
 from . import util
+from .gather_difference import SceneBefore, runs_within, window_arrays
 from .gather_texel_list import TexelList, entry_bytes, faces_reaching_cells
 from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .gather_shaders import (ACCUM_FORMATS, ACCUM_NAMES, FORMAT_CHANNELS, GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE,
@@ -82,12 +85,14 @@ def views_per_dispatch(plan: BakePlan) -> int:
     if plan.layered:
         return 1
     most = int(np.clip(DEPTH_BATCH_BYTES // (4 * plan.max_view_side**2), 1, VIEWS_PER_DISPATCH))
+    if plan.before_drawn is not None:  # a re-bake by difference: each direction's maps before and after
+        return 2 * max(1, most // 2)
     directions = max(1, plan.direction_count)
     batches = math.ceil(directions / most)
     return math.ceil(directions / batches)
 
 
-class GatherBaker(TexelList, LightViewBaker):
+class GatherBaker(TexelList, SceneBefore, LightViewBaker):
     """Owns the depth map, the texel list and its accumulators for one bake."""
 
     METHOD = "gather"
@@ -126,6 +131,7 @@ class GatherBaker(TexelList, LightViewBaker):
             self.depth_fbs = [gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=self.dummy)
                               for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
+        self.pending_signs: list[float] = []  # each pending view's: -1 the scene before an edit
         # GatherViews: one buffer per bake, rewritten before each dispatch.
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
@@ -137,10 +143,12 @@ class GatherBaker(TexelList, LightViewBaker):
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
         self.lifted = self.plan.lifts_terminator and (self.receivers is None or self.receivers.lift is not None)
+        self.entry_blocks = None  # (B, 2, 3) boxes of the entries' blocks (views cropped to spheres)
         self._build_texel_list()
         self.stats = dict(cpu_receivers=self.receivers is not None, view_pixels=0, directions_done=0,
                           texel_list_entries=self.entry_count, depth_faces_drawn=0, depth_faces_skipped=0,
                           averted_faces_drawn=0, averted_faces_skipped=0,
+                          window_faces_drawn=0, window_faces_skipped=0,
                           views_per_dispatch=self.slots, texel_tests=0, texel_tests_skipped=0,
                           layered=self.layered, layer_overflow_pixels=0,
                           shading_normals=self.plan.smooth_shading, terminator_lift=self.lifted)
@@ -149,11 +157,19 @@ class GatherBaker(TexelList, LightViewBaker):
         """Light views draw light-facing faces, plus averted ones only near holes: in Morton
         order, so that those are a few runs (core/bake/face_chunks.py)."""
         plan = self.plan
-        self.chunks = None
+        self.chunks = self.window_chunks = None
         self.hole_runs: dict[int, list[tuple[int, int]]] = {}
+        self.window_runs: dict[int, list[tuple[int, int]]] = {}
+        self._before_setup()
         if plan.holes is None:
-            return None
+            if plan.cells is None or plan.layered or plan.alpha is not None:
+                return None
+            # A run of some cells draws each view in its window alone: the chunks there.
+            self.window_chunks = face_chunks(plan.drawn_positions)
+            return self.window_chunks.order
         self.chunks = face_chunks(plan.drawn_positions)
+        if plan.cells is not None and not plan.layered:  # a window's faces: the same chunks
+            self.window_chunks = self.chunks
         return self.chunks.order
 
     def _light_view_batch(self, order: np.ndarray | None) -> "gpu.types.GPUBatch":
@@ -189,6 +205,14 @@ class GatherBaker(TexelList, LightViewBaker):
             runs = hole_chunk_ranges_many(self.chunks, self.plan.holes, np.stack([v.matrix for v in views]),
                                           len(self.chunks.order))
             self.hole_runs = dict(zip(indices, runs))
+        self.window_runs = {}
+        cropped = [(index, view) for index, view in zip(indices, views) if view.whole is not None]
+        if self.window_chunks is not None and cropped:
+            runs = window_chunk_ranges_many(self.window_chunks, *window_arrays([v for _, v in cropped]),
+                                            len(self.window_chunks.order))
+            self.window_runs = {index: [(first, first + count) for first, count in run]
+                                for (index, _), run in zip(cropped, runs)}
+            self._before_fitted([index for index, _ in cropped], [v for _, v in cropped])
 
     def _entry_runs(self, omegas: np.ndarray) -> list[tuple[int, int]]:
         """(first entry, end entry) runs of the bins that can face one of omegas (k, 3)."""
@@ -197,6 +221,15 @@ class GatherBaker(TexelList, LightViewBaker):
         else:
             needed = np.ones(BIN_COUNT, bool)
         return bin_runs(needed, self.bin_first)
+
+    def _tested_runs(self, views: list) -> list[tuple[int, int]]:
+        """(first entry, end entry) runs a dispatch of views tests: of the bins that can face
+        one of them, and of views cropped to spheres only the blocks their windows reach."""
+        runs = self._entry_runs(np.array([view.omega for view in views]))
+        if self.entry_blocks is None:
+            return runs
+        meets = boxes_meeting_windows(self.entry_blocks, *window_arrays(views))
+        return intersected_runs(runs, block_runs(meets.any(axis=0), self.entry_count))
 
     def sample_receivers(self, cells: np.ndarray, draw: int = 0) -> Receivers:
         """The list's receivers at `cells` (flat texel indices): this bake's own sample points,
@@ -250,11 +283,12 @@ class GatherBaker(TexelList, LightViewBaker):
     def _release(self) -> None:
         self.depths = self.depth_fbs = self.dummy = self.views_block = self.facing_batch = self.face_bins = None
         self.layer_count = self.layer_depth = self.overflow = self.layers_fb = None
-        self.pending = []
-        self.chunks = None
+        self.pending, self.pending_signs = [], []
+        self.chunks = self.window_chunks = None
+        self._before_release()
         self.entry_position = self.entry_normal = self.entry_texel = self.entry_lift = None
         self.accums = []
-        self.receivers = self.entry_texels = self.entry_cells = None
+        self.receivers = self.entry_texels = self.entry_cells = self.entry_blocks = None
         super()._release()
 
     def run_direction(self, index: int) -> None:
@@ -268,8 +302,13 @@ class GatherBaker(TexelList, LightViewBaker):
                                else 'NONE', self.layer_count, self.layer_depth, self.overflow, alpha)
             else:
                 culling, runs = self._depth_map_faces(index)
-                facing = None
-                if culling != 'NONE' and NORMAL_BINNING and alpha is None:  # faces turned towards ('BACK') or away from the light
+                # A cropped view draws its window's faces (with any culling: it is per face).
+                facing = self._window_faces(index) if alpha is None else None
+                if facing is not None:
+                    runs = runs_within(runs, facing[1])
+                    if self.before_batch is not None:
+                        self._draw_before(index, view)
+                if facing is None and culling != 'NONE' and NORMAL_BINNING and alpha is None:  # faces turned towards ('BACK') or away from the light
                     toward = view.omega if culling == 'BACK' else -view.omega
                     facing = (self.facing_batch, self.face_bins.runs(toward))
                     drawn = sum(end - first for first, end in facing[1])
@@ -278,10 +317,22 @@ class GatherBaker(TexelList, LightViewBaker):
                 depth_prepass(self.depth_fbs[len(self.pending)], self.all_batch, view, culling, runs, facing,
                               positions_only=True, alpha=alpha)
         self.pending.append(view)
+        self.pending_signs.append(1.0)
         if len(self.pending) == self.slots or index == plan.direction_count - 1:
             self._test_pending_views()
         self.stats["view_pixels"] += view.width * view.height
         self.stats["directions_done"] += 1
+
+    def _window_faces(self, index: int) -> tuple | None:
+        """(all_batch, its (first face, end face) runs in the window) of a cropped view, counted,
+        or None: a view drawn whole, or faces drawn by culling."""
+        if index not in self.window_runs:
+            return None
+        runs = self.window_runs[index]
+        drawn = sum(end - first for first, end in runs)
+        self.stats["window_faces_drawn"] += drawn
+        self.stats["window_faces_skipped"] += len(self.window_chunks.order) - drawn
+        return self.all_batch, runs
 
     def _depth_map_faces(self, index: int) -> tuple[str, list[tuple[int, int]]]:
         """(culling, averted face runs) of direction `index`'s depth map. The map must hold the
@@ -302,7 +353,7 @@ class GatherBaker(TexelList, LightViewBaker):
 
     def _test_pending_views(self) -> None:
         """One compute pass tests every texel-list entry against the pending views' depth maps."""
-        views, self.pending = self.pending, []
+        views, signs, self.pending, self.pending_signs = self.pending, self.pending_signs, [], []
         if not views or not self.entry_count:
             return
         block = self.views_data[0]
@@ -315,7 +366,7 @@ class GatherBaker(TexelList, LightViewBaker):
             # the smooth bunny's texel tests 17 % slower on llvmpipe (96 directions: 0.85 s
             # against 0.71 s, medians of 8 interleaved).
             block["plane_slope"][k][:2] = grid.plane_slope()
-            block["omega"][k] = (*view.omega, 0.0)
+            block["omega"][k] = (*view.omega, signs[k])  # w < 0: the scene before an edit (DIFFERENCE)
             span = grid.depth_far - grid.depth_near
             block["view_info"][k] = (grid.width, grid.height, grid.pixel_size / span, span)
             block["window"][k] = (*view.first, view.width, view.height)
@@ -324,7 +375,8 @@ class GatherBaker(TexelList, LightViewBaker):
         # One variant per bake: a last, short batch fills the other slots with padding (omega 0).
         shader = gather_shader(settings.weighting == "uniform", self.slots, self.shading_layout,
                                self.plan.layered_falloff if self.layered else None, self.lifted, self.plan.estimator,
-                               settings.spread_cos, self.plan.alpha is not None and self.plan.alpha.mode == "blend")
+                               settings.spread_cos, self.plan.alpha is not None and self.plan.alpha.mode == "blend",
+                               self.before_batch is not None)
         shader.bind()
         shader.uniform_block("views", self.views_block)
         if self.layered:
@@ -345,7 +397,7 @@ class GatherBaker(TexelList, LightViewBaker):
         # On llvmpipe an invocation costs its whole shader whether or not its entry faces a
         # view, so entries of bins that face none of these views are not dispatched at all.
         tested = 0
-        for first, end in self._entry_runs(np.array([view.omega for view in views])):
+        for first, end in self._tested_runs(views):
             shader.uniform_int("first_entry", first)
             shader.uniform_int("entry_end", end)
             count = end - first

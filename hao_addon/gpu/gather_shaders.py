@@ -120,7 +120,7 @@ ACCUM_BINDINGS = (2, 6)
 
 
 def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, terminator: bool,
-                 estimator: Estimator, spread_cos: float = 0.0, alpha_taps: bool = False
+                 estimator: Estimator, spread_cos: float = 0.0, alpha_taps: bool = False, difference: bool = False
                  ) -> "gpu.types.GPUShaderCreateInfo":
     """falloff: None for unlimited distance (depth maps), else the max-distance falloff
     ('none', 'wendland'), tested against per-pixel depth lists; terminator: entries carry
@@ -149,6 +149,8 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         info.define("SPREAD_COS", repr(float(spread_cos)))
     if alpha_taps:
         info.define("ALPHA_TAPS", "1")
+    if difference:
+        info.define("DIFFERENCE", "1")
     info.push_constant('INT', "first_entry")
     info.push_constant('INT', "entry_end")
     info.typedef_source(glsl_struct("GatherViews", GATHER_VIEWS_DTYPE))
@@ -181,12 +183,15 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
                  estimator=(AMBIENT_OCCLUSION, BENT_NORMALS), spread_cos=(0.0, 0.5), alpha_taps=(False, True))
 def gather_shader(uniform: bool, views: int = 1, shading: bool = False, falloff: str | None = None,
                   terminator: bool = False, estimator: Estimator = AMBIENT_OCCLUSION,
-                  spread_cos: float = 0.0, alpha_taps: bool = False) -> "gpu.types.GPUShader":
+                  spread_cos: float = 0.0, alpha_taps: bool = False, difference: bool = False
+                  ) -> "gpu.types.GPUShader":
     """The texel test of `views` (1 to GATHER_MAX_VIEWS) directions per dispatch; shading:
     entries carry shading normals (plan.smooth_shading); falloff, terminator, estimator: see
     _gather_info; spread_cos: the spread cone's cut-off (0: the hemisphere); alpha_taps: each
     depth test the mean of four pixels (plan.alpha 'blend': four draws of its stochastic
-    keeping for the noise of one)."""
-    key = ("bake_gather", uniform, views, shading, falloff, terminator, estimator.define, spread_cos, alpha_taps)
+    keeping for the noise of one); difference: views of the scene before an edit (omega.w <
+    0) subtract (hao_addon/rebake_difference.py)."""
+    key = ("bake_gather", uniform, views, shading, falloff, terminator, estimator.define, spread_cos, alpha_taps,
+           difference)
     return cached_shader(key, lambda: _gather_info(uniform, views, shading, falloff, terminator, estimator, spread_cos,
-                                                   alpha_taps))
+                                                   alpha_taps, difference))

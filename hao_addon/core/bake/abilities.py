@@ -51,7 +51,9 @@ class BakerDeclaration:
     bakes_all_cells: why the baker bakes every texel of its target even when a plan names the
     cells still needed (BakePlan.cells: the later rounds of a bake to an error); '' when it
     bakes only those. floor_unchecked: why the bake's visibility floor is not measured
-    (hao_addon/floor_check.py: exact rays at sampled texels along its own directions); '' when it is."""
+    (hao_addon/floor_check.py: exact rays at sampled texels along its own directions); '' when it is.
+    crops_views: its light views can be cropped to spheres (BakeRun.window_spheres), a
+    receiver outside reading lit: a re-bake by difference (hao_addon/rebake_difference.py)."""
 
     method: str
     label: str
@@ -60,6 +62,7 @@ class BakerDeclaration:
     auto_for: frozenset[str] = frozenset()
     bakes_all_cells: str = ""
     floor_unchecked: str = ""
+    crops_views: bool = False
 
     def can(self, ability: str) -> bool:
         return ability not in self.cannot
@@ -79,7 +82,7 @@ BAKERS = (
                 "color-attribute": "it rasterizes the UV layout"},
         bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
     BakerDeclaration(
-        "gather", "shadow-map gather", gpu=True,
+        "gather", "shadow-map gather", gpu=True, crops_views=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "
                              "walls: 0.006 too thin on a ball, measured by tests/test_thickness.py"}),
     BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False,

@@ -30,6 +30,9 @@ class BakeRun:
     cells: np.ndarray | None = None
     ao_only: bool = False
     needs: frozenset[str] = frozenset()
+    # (k, 4) world spheres the light views are cropped to (a re-bake by difference draws and
+    # reads only the pixels an edit can change: hao_addon/rebake_difference.py), or None.
+    window_spheres: np.ndarray | None = None
 
     @classmethod
     def of(cls, settings: BakeSettings, needs: frozenset[str] = frozenset()) -> "BakeRun":
@@ -38,3 +41,6 @@ class BakeRun:
 
     def with_cells(self, cells: np.ndarray | None) -> "BakeRun":
         return replace(self, cells=cells)
+
+    def with_windows(self, spheres: np.ndarray | None) -> "BakeRun":
+        return replace(self, window_spheres=spheres)

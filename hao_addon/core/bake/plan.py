@@ -32,7 +32,7 @@ from .target_kinds import TARGET_KINDS, TargetKind
 from .targets import BakeTarget, as_bake_target
 from .vertex_target import VertexTarget
 from .view_size import DENSE_AREA_LIMIT, light_pixel_size
-from .views import OrthoView, fit_views
+from .views import OrthoView, fit_views, pixel_jitter
 
 
 @dataclass
@@ -73,6 +73,12 @@ class BakePlan:
     # the whole views.
     window_faces: np.ndarray | None = None
     window_points: np.ndarray | None = None
+    # (k, 4) float64 normalized spheres each view is cropped to instead (a re-bake by
+    # difference, hao_addon/rebake_difference.py: only pixels an edit can change are drawn).
+    window_spheres: np.ndarray | None = None
+    # (drawn (F', 3, 3) float32 normalized, holes as `holes`) of the scene before an edit, for a
+    # re-bake by difference (its views subtract: gpu_shaders/bake_gather.comp, DIFFERENCE).
+    before_drawn: tuple | None = None
     needs_footprint_splat: bool = False
     # Some corner's shading normal differs from its face normal: the passes then weight by
     # the shading normal and handle the terminator (directions above the shading hemisphere
@@ -221,7 +227,7 @@ class BakePlan:
         reaches = [float(omega @ c) + r for omega in omegas]
         jitters = np.array([pixel_jitter(self.seed, i) for i in indices]).reshape(-1, 2)
         return fit_views(omegas, self.target_points, reaches, self.pixel_size, jitters, self.max_view_side,
-                         self.window_points)
+                         self.window_points, self.window_spheres)
 
 
 def _window_faces(target, settings: BakeSettings, run: BakeRun, layout: TexelLayout, method: str
@@ -236,19 +242,6 @@ def _window_faces(target, settings: BakeSettings, run: BakeRun, layout: TexelLay
         return None
     faces = faces_touching(target.uvs, settings.size, run.cells)
     return faces if len(faces) else None
-
-
-# The R2 sequence (Roberts 2018; 1/g, 1/g^2 with g the plastic number): pixel-grid offsets
-# that cover the unit square evenly in any run of views, at no cost (seeding a numpy
-# generator per view took 0.27 ms, 3 % of a light view).
-_PLASTIC = 1.324717957244746
-_R2_STEP = np.array([1.0 / _PLASTIC, 1.0 / _PLASTIC**2])
-
-
-def pixel_jitter(seed: int, index: int) -> np.ndarray:
-    """(2,) sub-pixel offset in [0, 1) of light view `index` of a bake with `seed`."""
-    start = np.array([0.5, 0.5]) + (seed % 1_000_003) * np.array([0.7548776662466927, 0.5698402909980532])
-    return np.mod(start + index * _R2_STEP, 1.0)
 
 
 def asked_phrases(udim: UdimLayout | None) -> dict[str, str]:
@@ -330,6 +323,8 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         # Distinct corners: a light view's window is fitted to them (shared corners once).
         target_points=layout.view_points(t_pos.reshape(-1, 3)[target_weld[0]], pixel_size),
         window_faces=window, window_points=None if window is None else t_pos[window].reshape(-1, 3),
+        window_spheres=None if run.window_spheres is None else run.window_spheres / np.array([scale] * 4)
+        - np.append(centre / scale, 0.0),
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
         smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
         stats=stats, alpha=alpha)

@@ -44,6 +44,9 @@ class SceneState:
     settings_key: str
     target_layout: str
     soups: dict[str, SoupState] = field(default_factory=dict)
+    # (target, occluders) as baked, where kept: a re-bake by difference bakes the scene
+    # before the edit again where the edit can have changed it (hao_addon/rebake_difference.py).
+    scene: tuple | None = field(default=None, compare=False, repr=False)
 
 
 TARGET = "\0target"  # the target's entry in SceneState.soups (no object is called so)
@@ -99,7 +102,7 @@ def scene_state(target: TriangleSoup, occluders: list[TriangleSoup], settings_ke
     soups = {TARGET: soup_state(target)}
     for soup in occluders:
         soups[soup.name] = soup_state(soup)
-    return SceneState(settings_key, layout, soups)
+    return SceneState(settings_key, layout, soups, (target, list(occluders)))
 
 
 def changed_faces(before: SceneState, after: SceneState) -> list[np.ndarray]:
