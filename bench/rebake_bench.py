@@ -14,8 +14,9 @@ size: one whole bake of the base scene (Auto's method: the gather), then per edi
 incremental re-bake from it and the whole bake of the edited scene (each once, after one
 untimed bake for the shaders): the share of texels re-baked, the speed-up (whole seconds /
 incremental seconds), the largest |incremental - whole| over the kept texels beside the
-report's bound on them, and over the re-baked ones (0: the gather bakes a subset as its
-whole bake does, tests/test_rebake.py). Writes rebake_bench.json and rebake_bench.png.
+report's bound on them, and over the re-baked ones (float rounding: the gather re-bakes them
+by difference, tests/test_rebake_difference.py), and how they were baked. Writes
+rebake_bench.json and rebake_bench.png.
 """
 from __future__ import annotations
 
@@ -84,7 +85,8 @@ def size_rows(size: int, directions: int) -> list[dict]:
                      "kept_max_difference": float(diff[covered & ~redo].max(initial=0.0)),
                      "rebaked_max_difference": float(diff[covered & redo].max(initial=0.0)),
                      "kept_bound": report.kept_bound, "threshold": report.threshold,
-                     "stated_rmse": base.error.rmse, "rebaked_stated_rmse": result.error.rmse, "method": full.method})
+                     "stated_rmse": base.error.rmse, "rebaked_stated_rmse": result.error.rmse, "method": full.method,
+                     "how": report.how})
         print(json.dumps(rows[-1]), flush=True)
     return rows
 

@@ -238,10 +238,13 @@ def readme_numbers() -> str:
                  f"(xatlas alone: {old['seconds']:.1f} s), covering {new['coverage']:.2f} of the texels "
                  f"(xatlas: {old['coverage']:.2f}), no overlaps ([report](docs/benchmarks.md#auto-unwrap)).")
     rows = _load("rebake_bench")["rows"]
+    largest, smaller = max(r["size"] for r in rows), min(r["size"] for r in rows)
     spans = ", ".join(f"{100 * r['rebaked_share']:.2g} % in {r['incremental_s']:.1f} s against {r['full_s']:.1f} s "
-                      f"({r['speedup']:.1f}x)" for r in rows if r["size"] == max(x["size"] for x in rows))
+                      f"({r['speedup']:.1f}x)" for r in rows if r["size"] == largest)
+    also = ", ".join(f"{r['speedup']:.1f}x at {100 * r['rebaked_share']:.2g} %" for r in rows
+                     if r["size"] == smaller and smaller != largest)
     lines.append(f"- **Re-bake Changed**: after moving one ball of a scene, re-baking only the texels it can have "
-                 f"changed at {max(r['size'] for r in rows)}²: {spans}; "
+                 f"changed at {largest}²: {spans}" + (f" (at {smaller}²: {also})" if also else "") + "; "
                  f"{held(rows)} ([report](docs/benchmarks.md#re-bake-changed-against-a-whole-bake)).")
     farm = _load("farm_bench")
     lines.append(f"- **Farms**: {farm['inputs']} inputs as one farm task cost {farm['ratio_one_task_to_local_batch']:.2f}x "
@@ -250,10 +253,20 @@ def readme_numbers() -> str:
     return "\n".join(lines)
 
 
+# A re-bake by difference adds float32 sums: its texels may differ from a whole bake by this.
+REBAKE_ROUNDING = 1e-6
+
+
 def held(rows: list[dict]) -> str:
-    """Whether every kept texel of the re-bake benchmark lay within its report's bound."""
-    if all(r["kept_max_difference"] <= r["kept_bound"] + 1e-6 and r["rebaked_max_difference"] == 0.0 for r in rows):
-        return "every kept texel within the stated bound of a whole bake, every re-baked one equal to it"
+    """Whether every kept texel of the re-bake benchmark lay within its report's bound, and
+    every re-baked one equal to a whole bake's (up to rounding)."""
+    if all(r["kept_max_difference"] <= r["kept_bound"] + 1e-6 for r in rows):
+        worst = max(r["rebaked_max_difference"] for r in rows)
+        if worst == 0.0:
+            return "every kept texel within the stated bound of a whole bake, every re-baked one equal to it"
+        if worst <= REBAKE_ROUNDING:
+            return (f"every kept texel within the stated bound of a whole bake, every re-baked one equal to it up to "
+                    f"float rounding (at most {worst:.1e})")
     return "NOT every texel within the stated bound of a whole bake: see the report"
 
 
