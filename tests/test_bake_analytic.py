@@ -209,17 +209,21 @@ def test_gather_batched_directions_equal_one_per_dispatch(gpu_context, monkeypat
 def test_gather_batch_size_follows_the_depth_map_budget():
     """A dispatch's depth maps stay within DEPTH_BATCH_BYTES: 16 views up to 1024^2 pixels,
     4 at 2048^2, one beyond; the directions split into batches of equal size (few padded
-    slots); max-distance bakes (depth lists) one per dispatch."""
+    slots); max-distance bakes (depth lists) one per dispatch; a re-bake by difference views in
+    pairs (each direction before and after)."""
     from types import SimpleNamespace
     import hao_addon.gpu.bake_gather as bake_gather
 
-    def per_dispatch(side, directions=256, max_distance=0.0):
+    def per_dispatch(side, directions=256, max_distance=0.0, before_drawn=None):
         settings = SimpleNamespace(max_distance=max_distance, directions=directions)
         return bake_gather.views_per_dispatch(SimpleNamespace(max_view_side=side, settings=settings,
-                                                              layered=max_distance > 0.0, direction_count=directions))
+                                                              layered=max_distance > 0.0, direction_count=directions,
+                                                              before_drawn=before_drawn))
     assert [per_dispatch(s) for s in (256, 1024, 1448, 2048, 4096)] == [16, 16, 8, 4, 1]
     assert [per_dispatch(256, d) for d in (1, 8, 16, 20, 64, 96, 100)] == [1, 8, 16, 10, 16, 16, 15]
     assert per_dispatch(256, max_distance=1.0) == 1
+    # a re-bake by difference draws each direction before and after: views come in pairs
+    assert [per_dispatch(s, before_drawn=()) for s in (256, 2048, 4096)] == [16, 4, 2]
 
 
 @pytest.mark.parametrize("shading", ["face", "smooth"])
