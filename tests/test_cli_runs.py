@@ -13,6 +13,7 @@ import sys
 import time
 from pathlib import Path
 
+import bpy
 import numpy as np
 import pytest
 
@@ -64,6 +65,7 @@ def test_object_token_and_json_report(dirs):
     data = json.loads(report.read_text())
     # The bundled sample bakes without a warning of its own: status ok.
     assert data["status"] == "ok" and data["exit_code"] == 0 and data["error"] is None and data["warnings"] == []
+    assert data["blender"] == bpy.app.version_string
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
@@ -87,6 +89,7 @@ def test_object_token_and_json_report(dirs):
     assert proc.returncode == 2 and data["status"] == "error" and "map size" in data["error"]
     assert data["exit_code"] == 2 and data["outputs"] == [] and not (out / "x.png").exists()
     assert "bake" not in data["timings"] and "load" not in data["timings"]  # refused before any work
+    assert data["blender"] == ""  # refused before Blender was loaded
 
 
 def test_obj_smoothing_groups_and_vn_normals_shade_the_bake(dirs):
@@ -145,7 +148,8 @@ def test_several_meshes_bake_the_active_one_and_say_it_or_are_refused(dirs, tmp_
 
 def test_output_checks_come_before_any_work(dirs):
     """A legal 254-byte name bakes (the temporary name is short); a folder that cannot be
-    made fails before the scene is loaded or the GPU is touched."""
+    made fails before the scene is loaded, the GPU is touched, or Blender itself is loaded
+    (a refused run ends in a fraction of a second)."""
     out, tmp = dirs
     name = "a" * 250 + ".png"
     proc = run(["bake", SPOT, "--size", "64", "--directions", "8", "--out", out / name, "--quiet"], tmp)
@@ -156,7 +160,20 @@ def test_output_checks_come_before_any_work(dirs):
         proc = run([*command, "--out", out / "file" / "x.png", "--json", report], tmp)
         data = json.loads(report.read_text())
         assert proc.returncode == 2 and "is a file, not a folder" in proc.stderr
-        assert set(data["timings"]) == {"total"}, data["timings"]
+        assert set(data["timings"]) == {"total"} and data["blender"] == "", data
+    proc = run(["farm", "verify", "--manifest", out / "none.json", "--out-dir", out, "--json", report], tmp)
+    data = json.loads(report.read_text())  # Verify reads files only: it never loads Blender
+    assert proc.returncode == 2 and "cannot read the manifest" in proc.stderr and data["blender"] == "", data
+
+
+def test_no_gpu_is_exit_3_once_the_gpu_module_is_loaded():
+    """A failed GPU context is exit 3 with its own line; the error handler recognizes it
+    without importing the GPU module itself (that would load Blender for an argument error)."""
+    from hao_addon.cli import errors as cli_errors
+    from hao_addon.gpu.context import GPUUnavailableError
+
+    assert cli_errors.failure(GPUUnavailableError("could not create a GPU context: x"), None) == (
+        cli_errors.EXIT_NO_GPU, "could not create a GPU context: x")
 
 
 def test_unwrap_warnings_for_overlapping_and_outside_uvs(tmp_path):

@@ -18,7 +18,7 @@ from .. import __version__
 from .bake import fill_input_token, run_bake
 from .batch import run_batch
 from .errors import CLIError, EXIT_FAILURE, EXIT_OK, failure
-from .io import (deferred_signals, EXIT_INTERRUPTED, OpenJDProgress, ProcessOutput, Progress, REPORT, Report,
+from .io import (EXIT_INTERRUPTED, OpenJDProgress, ProcessOutput, Progress, REPORT, Report,
                      signals_as_exceptions)
 from .parser import parse
 from .render import run_render_ao
@@ -56,11 +56,6 @@ def run_farm_command(args, report: Report, progress: Progress) -> list[str]:
 COMMANDS = {"bake": run_bake_command, "render-ao": run_render_ao, "farm": run_farm_command}
 
 
-def _needs_blender(args) -> bool:
-    """Whether the command loads Blender (writing a farm job does not: 10,000 inputs in seconds)."""
-    return args.command != "farm" or args.farm_command == "verify"
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     started = time.perf_counter()
@@ -69,10 +64,6 @@ def main(argv: list[str] | None = None) -> int:
         args = None
         try:
             args = parse(argv, io)
-            if _needs_blender(args):
-                with deferred_signals():
-                    import bpy
-                report.blender = bpy.app.version_string
             if getattr(args, "progress", "") == "openjd":  # a farm task: its progress for the farm
                 progress = OpenJDProgress(io.out)
             else:

@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from .errors import CLIError
-from .io import check_signals, deferred_signals, Progress, REPORT, Report
+from .io import check_signals, deferred_signals, load_blender, Progress, REPORT, Report
 from .options import option_for, settings_from_args
 from .parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
 from .scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
@@ -46,11 +46,9 @@ class _Run:
 def run_bake(args, report: Report, progress: Progress) -> list[str]:
     """Bake one input (args.input): check every file, load, pick the meshes, bake, write all
     or nothing; returns the summary lines to print."""
-    import bpy
-
-    from ..blender.bake_job import BakeJob
-
     run = _checked_run(args, report)
+    bpy = load_blender(report)
+    from ..blender.bake_job import BakeJob
     with report.phase("load"):
         progress.update("loading")
         load_scene(run.source)

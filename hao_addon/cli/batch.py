@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .bake import fill_input_token, GLTF_OUT, has_token, image_outputs, run_bake, to_colors
 from .errors import CLIError, failure
-from .io import Progress, REPORT, Report, Terminated
+from .io import load_blender, Progress, REPORT, Report, Terminated
 from .parser import BATCH_NAME, EXTRA_OUTPUT_OPTIONS
 from ..core.folders import nearest_existing, unmakeable_reason
 from ..core.output_files import check_output_files, INPUT_TOKEN, OBJECT_TOKEN
@@ -58,8 +58,9 @@ def run_batch(args, report: Report, progress: Progress) -> list[str]:
     template = args.out or BATCH_NAME
     if os.path.dirname(template):
         raise CLIError(f"with --out-dir, --out is a file name in it, not a path: '{template}'")
-    from ..gpu.shaders import cached_shader_count
     subs, reads = batch_plan(args, folder, template)
+    load_blender(report)
+    from ..gpu.shaders import cached_shader_count
     lines, written = [], []
     for index, sub in enumerate(subs):
         path = sub.input

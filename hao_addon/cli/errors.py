@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 import traceback
 
 from .io import EXIT_INTERRUPTED, pending_signal, ProcessOutput, Terminated
@@ -40,11 +41,10 @@ def failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
         return EXIT_INTERRUPTED[signal.SIGTERM], "terminated (SIGTERM): nothing was written"
     if isinstance(exc, CLIError):
         return exc.code, str(exc)
-    try:
-        from ..gpu.context import GPUUnavailableError
-    except ImportError:  # no bpy at all
-        GPUUnavailableError = ()  # noqa: N806
-    if GPUUnavailableError and isinstance(exc, GPUUnavailableError):
+    # Only a run that loaded the GPU module can have failed for want of a GPU (importing it
+    # here would load Blender for an error found before it).
+    context = sys.modules.get(__package__.rpartition(".")[0] + ".gpu.context")
+    if context is not None and isinstance(exc, context.GPUUnavailableError):
         return EXIT_NO_GPU, last_line(exc)
     if isinstance(exc, (UserInputError, OSError)):  # bake and view input, UnwrapError, SettingError
         return EXIT_BAD_INPUT, last_line(exc)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from .bake import start_gpu, validated
 from .errors import CLIError
-from .io import check_signals, Progress, REPORT, Report
+from .io import check_signals, load_blender, Progress, REPORT, Report
 from .options import settings_from_args
 from .parser import INPUT_FORMATS
 from .scene import check_input, check_json_target, load_scene
@@ -16,11 +16,8 @@ from ..core.output_files import check_output_files
 
 
 def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
-    import bpy
-
     from ..core.imageio import check_writable, write_ao_file
     from ..core.hao.view_settings import RenderSize, ViewAOSettings
-    from ..render_ao import render_camera_ao
 
     size = validated(settings_from_args(args, RenderSize), RenderSize)
     settings = validated(settings_from_args(args, ViewAOSettings), ViewAOSettings)
@@ -33,6 +30,8 @@ def run_render_ao(args, report: Report, progress: Progress) -> list[str]:
     check_json_target(args.json)
     check_output_files([(str(out), "the AO image (--out)"), (args.json or "", REPORT)],
                        [(str(source), "the input file")])
+    bpy = load_blender(report)
+    from ..render_ao import render_camera_ao
     with report.phase("load"):
         progress.update("loading")
         load_scene(source)
