@@ -470,3 +470,22 @@ def test_plane_slope_is_the_clip_space_normals_slope():
         expected = -clip[:, :2] / (clip[:, 2:] * [view.width, view.height])
         m = normals @ linear.T
         np.testing.assert_allclose(view.plane_slope() * m[:, :2] / m[:, 2:], expected, rtol=1e-5, atol=1e-12)
+
+
+def test_surface_holes_are_remembered_by_their_corners(monkeypatch):
+    """A re-bake plans the same scenes again: the holes of corners seen among the last few
+    come back without being found again, read-only; other corners (one bit) are found anew."""
+    from hao_addon.core import geometry, scenes
+    torus = scenes.torus(1.0, 0.4, (0, 0, 0), 24, 12).positions
+    holed = np.delete(torus, [0, 100], axis=0)
+    first = geometry.surface_holes(holed)
+    found = []
+    monkeypatch.setattr(geometry, "_surface_holes", lambda *a: found.append(1) or [])
+    assert geometry.surface_holes(holed.copy()) is first and found == []
+    assert all(not loop.flags.writeable for loop in first)
+    nudged = holed.copy()
+    nudged.view(np.uint64)[5, 1, 2] ^= np.uint64(1)  # one bit of one corner
+    assert geometry.surface_holes(nudged) == [] and found == [1]
+    for k in range(geometry.HOLES_REMEMBERED):  # pushed out by others
+        geometry.surface_holes(holed + k + 1.0)
+    assert geometry.surface_holes(holed) == [] and len(found) == 2 + geometry.HOLES_REMEMBERED

@@ -237,14 +237,17 @@ def readme_numbers() -> str:
     lines.append(f"- **Auto-unwrap**: the 69,451-triangle bunny without UVs unwraps in {new['seconds']:.1f} s at 256² "
                  f"(xatlas alone: {old['seconds']:.1f} s), covering {new['coverage']:.2f} of the texels "
                  f"(xatlas: {old['coverage']:.2f}), no overlaps ([report](docs/benchmarks.md#auto-unwrap)).")
-    rows = _load("rebake_bench")["rows"]
+    rebakes = _load("rebake_bench")
+    rows = rebakes["rows"]
+    repeats = rebakes.get("repeats", 1)
     largest, smaller = max(r["size"] for r in rows), min(r["size"] for r in rows)
     spans = ", ".join(f"{100 * r['rebaked_share']:.2g} % in {r['incremental_s']:.1f} s against {r['full_s']:.1f} s "
                       f"({r['speedup']:.1f}x)" for r in rows if r["size"] == largest)
     also = ", ".join(f"{r['speedup']:.1f}x at {100 * r['rebaked_share']:.2g} %" for r in rows
                      if r["size"] == smaller and smaller != largest)
     lines.append(f"- **Re-bake Changed**: after moving one ball of a scene, re-baking only the texels it can have "
-                 f"changed at {largest}²: {spans}" + (f" (at {smaller}²: {also})" if also else "") + "; "
+                 f"changed at {largest}²: {spans}" + (f" (at {smaller}²: {also})" if also else "")
+                 + (f" (medians of {repeats} runs)" if repeats > 1 else "") + "; "
                  f"{held(rows)} ([report](docs/benchmarks.md#re-bake-changed-against-a-whole-bake)).")
     farm = _load("farm_bench")
     lines.append(f"- **Farms**: {farm['inputs']} inputs as one farm task cost {farm['ratio_one_task_to_local_batch']:.2f}x "
