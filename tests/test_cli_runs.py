@@ -167,8 +167,8 @@ def test_output_checks_come_before_any_work(dirs):
 
 
 def test_no_gpu_is_exit_3_once_the_gpu_module_is_loaded():
-    """A failed GPU context is exit 3 with its own line; the error handler recognizes it
-    without importing the GPU module itself (that would load Blender for an argument error)."""
+    """A failed GPU context is exit 3 with its own line; the error handler knows the error
+    from the core (importing the GPU module would load Blender for an argument error)."""
     from hao_addon.cli import errors as cli_errors
     from hao_addon.gpu.context import GPUUnavailableError
 

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import os
-import sys
 import traceback
 
 from .io import EXIT_INTERRUPTED, pending_signal, ProcessOutput, Terminated
-from ..core.errors import UserInputError
+from ..core.errors import GPUUnavailableError, UserInputError
 
 
 EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_NO_GPU = 0, 1, 2, 3
@@ -41,10 +40,7 @@ def failure(exc: BaseException, io: ProcessOutput | None) -> tuple[int, str]:
         return EXIT_INTERRUPTED[signal.SIGTERM], "terminated (SIGTERM): nothing was written"
     if isinstance(exc, CLIError):
         return exc.code, str(exc)
-    # Only a run that loaded the GPU module can have failed for want of a GPU (importing it
-    # here would load Blender for an error found before it).
-    context = sys.modules.get(__package__.rpartition(".")[0] + ".gpu.context")
-    if context is not None and isinstance(exc, context.GPUUnavailableError):
+    if isinstance(exc, GPUUnavailableError):
         return EXIT_NO_GPU, last_line(exc)
     if isinstance(exc, (UserInputError, OSError)):  # bake and view input, UnwrapError, SettingError
         return EXIT_BAD_INPUT, last_line(exc)

@@ -13,3 +13,8 @@ class BakeInputError(UserInputError):
 
 class ViewInputError(UserInputError):
     """The scene or view cannot be rendered with viewport AO (HAO)."""
+
+
+class GPUUnavailableError(RuntimeError):
+    """Raised when no GPU context can be created (no EGL/OpenGL driver). Defined here, below
+    the GPU module, so that the command line's error handler knows it without loading Blender."""

@@ -15,9 +15,7 @@ import os
 import bpy
 import gpu
 
-
-class GPUUnavailableError(RuntimeError):
-    """Raised when no GPU context can be created (no EGL/OpenGL driver)."""
+from ..core.errors import GPUUnavailableError  # raised here; the operators name it from here
 
 
 def gpu_is_ready() -> bool:
