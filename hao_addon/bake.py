@@ -25,6 +25,7 @@ from .core.bake.plan import make_plan_steps
 from .core.bake.projection import HighToLow
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
     replicate_twin, with_floor, directions_for
+from .contact_repair import traced_contacts_steps
 from .floor_check import floor_sample, floor_steps, probe_steps, take_probe
 from .replicates import replicate_sums_steps
 from .core.bake.seams import dilate, finalize_vectors
@@ -240,9 +241,10 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         best = shared["floor_probe"].half if shared.get("floor_probe") else 0
         snapshots = probe_steps(method, count, best)
         sums_a, sums_b = yield from replicate_sums_steps(baker, count, share, snapshots)
+        contacts = yield from traced_contacts_steps(plan, baker, count, (sums_a, sums_b), shared)
         # The map is the replicates' mean (each receiver weighs 1 in each).
         sums = sums_b if sums_a is None else sums_a + sums_b
-        gpu_stats = dict(baker.stats)
+        gpu_stats = {**baker.stats, **contacts}
         if "floor_sample" not in shared:  # the first round's sample points serve every round
             # The texels the map's error covers: a scatter's texels under half covered are grown
             # from their neighbours, and checking their own partial sums stated a floor the map
@@ -301,7 +303,7 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     (SKIP_CONVERGED); stats' skippable_fraction is the share of texel directions that
     leaving converged texels out would have saved."""
     target_error, cap = settings.error_target, settings.direction_cap
-    stat_target, floor_seen = target_error, False
+    stat_target, floor_checks = target_error, 0
     rounds, history = [], []
     work = skipped = 0.0  # texel x direction pairs: all of them, and those left out
     size, done, shown, cells, skips = min(cap, PILOT_DIRECTIONS), 0, 0.0, None, True
@@ -321,12 +323,15 @@ def _bake_to_error(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             break
         history.append((done, combined.error.p99))
         size = next_round(history, stat_target, cap)
-        if not size and not floor_seen and done < cap:
-            floor_seen = True
+        # Checked again where the room left for the floor was too little (the quadrature sum
+        # understates the p99 of the floor and the noise per texel: a floor and ball landed 0.0315).
+        if not size and floor_checks < 3 and done < cap:
+            floor_checks += 1
             whole = yield from relay(_with_floor_steps(combined, shared, settings, target.name), lambda f: shown)
             floor_p99 = whole.error.floor_p99
             if whole.error.p99 > target_error and floor_p99 < FLOOR_REACH * target_error:
-                stat_target = target_error * math.sqrt(1.0 - (floor_p99 / target_error) ** 2)
+                stat_target = min(target_error * math.sqrt(1.0 - (floor_p99 / target_error) ** 2),
+                                  combined.error.p99 * target_error / whole.error.p99)
                 size = next_round(history, stat_target, cap)
         if size:  # the texels the next round needs: those not yet converged (all if none is)
             active = combined.covered & ~converged(combined.twin, combined.covered, target_error)
@@ -374,8 +379,8 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
         return result
     probe = shared["floor_probe"]
     if shared.get("floor_found", (None,))[0] is not probe:  # a bake to an error measures it once per probe
-        shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"],
-                                                                 result.error.directions)))
+        shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"], result.error.directions,
+                                                                 shared.get("contact_cells", ()))))
     found = shared["floor_found"][1]
     if found is None:
         return result

@@ -207,7 +207,7 @@ def refined_count(checked: int, probe: FloorProbe, directions: int) -> int:
     return int(min(math.ceil(checked * REFINED_SHARE), rays // max(per_texel, 1)))
 
 
-def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int
+def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_cells: np.ndarray = ()
                 ) -> Generator[float, None, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None]:
     """(cells (n,), floor_a (n,), floor_b (n,), weight (n,)): each replicate's partial value
     minus the reference's along the same directions from the same points, at
@@ -215,21 +215,28 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int
     for its cap, and checks it for the directions it has baked; its texels at risk stay), and
     at the refined_count() of them with the largest floors its whole value minus the
     reference's along all its directions; weight: the share of the covered texels each stands
-    for (FloorSample.weights). None where no cell is lit in both. Yields progress in [0, 1]."""
+    for (FloorSample.weights). None where no cell is lit in both. exact_cells: cells the bake
+    traced exactly after its probe (hao_addon/contact_repair.py): in the sample with a floor of
+    0, not traced again. Yields progress in [0, 1]."""
     values, full_values = probe.values, probe.full_values
     wanted = floor_texel_count(directions)
     keep = sample.thinning(wanted, np.random.default_rng([directions, FLOOR_SEED]))
     if keep is not None:
         sample, values, full_values = sample.part(keep), values[:, keep], full_values[:, keep]
     cells, receivers = sample.cells, sample.receivers
-    exact = yield from relay(_exact_steps(probe.plan, cells, receivers, probe.steps), lambda f: 0.5 * f)
+    traced = np.isin(cells, exact_cells)
+    untraced = np.flatnonzero(~traced)
+    exact = np.array(values, np.float64)  # a cell traced exactly: its floor is 0
+    exact[:, untraced] = yield from relay(
+        _exact_steps(probe.plan, cells[untraced], tuple(r.subset(np.isin(r.texel, cells[untraced])) for r in receivers),
+                     probe.steps), lambda f: 0.5 * f)
     seen = np.isfinite(exact).all(axis=0) & np.isfinite(values).all(axis=0)
     if not seen.any():
         return None
     floor = np.clip(values, 0.0, 1.0) - np.clip(exact, 0.0, 1.0)
     floor[:, ~seen] = 0.0
     refined = np.argsort(-(floor ** 2).sum(axis=0), kind="stable")[:refined_count(int(seen.sum()), probe, directions)]
-    refined = np.sort(refined[seen[refined]])
+    refined = np.sort(refined[seen[refined] & ~traced[refined]])
     if len(refined):
         subset = tuple(r.subset(np.isin(r.texel, cells[refined])) for r in receivers)
         exact_all = yield from relay(_exact_steps(probe.plan, cells[refined], subset, probe.full_steps),

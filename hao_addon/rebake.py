@@ -217,6 +217,12 @@ def _cells_steps(previous: BakeResult, before: SceneState, after_scene: tuple, s
         return part, f"baked whole: {found}"
     twin = None if previous.twin is None else previous.twin.reshape(-1)[cells]
     values, twins = merged_by_difference(previous.ao.reshape(-1)[cells], twin, found)
+    if len(found.traced):  # contacts: baked whole, traced exactly as a whole bake traces them
+        whole = yield from relay(bake_cells_steps(*after_scene, settings, found.traced), lambda f: 0.5 + 0.5 * f)
+        at = np.searchsorted(cells, found.traced)
+        values[at] = whole.ao.reshape(-1)[found.traced]
+        if twins is not None and whole.twin is not None:
+            twins[at] = whole.twin.reshape(-1)[found.traced]
     ao, covered = np.ones(previous.ao.shape, np.float32), np.zeros(previous.covered.shape, bool)
     ao.reshape(-1)[cells], covered.reshape(-1)[cells] = values, True
     part_twin = None

@@ -22,7 +22,7 @@ Elsewhere the cells are baked whole (rebake.py).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Generator
 
 import numpy as np
@@ -34,6 +34,7 @@ from .core.bake.scene_changes import SceneState
 from .core.bake.normalization import hemisphere_weight
 from .core.bake.settings import BakeSettings
 from .core.directions import replicate_sizes
+from .contact_repair import contact_cells
 from .core.steps import relay
 
 
@@ -42,7 +43,9 @@ class Difference:
     """What an edit changed of the cells' sums: changed (c,) the indices into the cells of
     those it changed, and at them, replicates a and b (a None with one replicate), the change
     of N and W (the same before and after), in texel_sums' units (each lit receiver weighs 1
-    in its texel)."""
+    in its texel). traced: (t,) the cells in contact with another surface before or after the
+    edit, whose values a whole bake traces exactly (hao_addon/contact_repair.py): a GPU
+    difference added to them would not be that value, so they are baked whole."""
 
     changed: np.ndarray
     change_a: np.ndarray | None
@@ -50,6 +53,7 @@ class Difference:
     weight_a: np.ndarray | None
     weight_b: np.ndarray
     stats: dict
+    traced: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
 
 def _same_views(a: BakePlan, b: BakePlan) -> bool:
@@ -95,7 +99,10 @@ def difference_steps(before: SceneState, settings: BakeSettings, after_scene: tu
     found = yield from relay(_entry_sums_steps(plan), lambda f: 0.1 + 0.9 * f)
     if found is None:
         return "its receivers are uploaded (sub-texel samples)"
-    return _texel_difference(*found, plan, cells)
+    traced = np.zeros(0, np.int64)
+    if declaration(plan.method).traces_contacts:
+        traced = np.intersect1d(np.union1d(*(contact_cells(p.with_cells(None)) for p in plans)), cells)
+    return replace(_texel_difference(*found, plan, cells), traced=traced)
 
 
 @dataclass(frozen=True)

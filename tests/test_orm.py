@@ -79,3 +79,15 @@ def test_material_images_and_values_fill_the_green_and_blue(scene, tmp_path):
     expected_green = np.linspace(0.0, 1.0, 8)[np.minimum((u * 8).astype(int), 7)]
     np.testing.assert_allclose(orm[..., 1], np.tile(expected_green, (32, 1)), atol=1e-6)
     np.testing.assert_allclose(orm[..., 2], 0.8, atol=1e-6)
+
+
+def test_orm_channels_past_the_margin_hold_their_mean_over_the_islands():
+    """Before: 0 past the margin, so an ORM texture was pure red there (roughness 0, a mirror)
+    and a mipmap's coarse levels blended it in."""
+    from hao_addon.core.bake.orm import channel_map
+    uvs = np.array([[[0.1, 0.1], [0.4, 0.1], [0.1, 0.4]], [[0.6, 0.6], [0.9, 0.6], [0.6, 0.9]]])
+    values = channel_map(uvs, 64, lambda face, bary: np.where(face == 0, 0.2, 0.6), margin=2)
+    inside = np.zeros((64, 64), bool)
+    inside[np.isclose(values, 0.2) | np.isclose(values, 0.6)] = True
+    corner, islands = values[63, 0], values[inside]
+    assert abs(corner - islands.mean()) < 1e-6 and 0.2 < corner < 0.6

@@ -31,12 +31,13 @@ from ..core.bake.settings import BakeSettings
 from ..core.bake.map_kinds import EXTRA_MAPS
 from ..core.bake.targets import BakeTarget
 from ..core.bake.texture_set import texture_set_target
-from ..core.bake.unwrap import check_unwrap_overlap, unwrap_steps
 from . import color_attributes, images, mesh_data
 from .bake_request import (TEXTURE_SET_NAME, BakeGroup, BakeRequest, input_files, output_kinds, output_path_for,
                            planned_files, terminator_settings, tile_paths, validate_request)
 from .map_producers import bent_normal_image, orm_map, surface_maps
 from .rebake_records import keeps_records, recorded_steps, remember_records, stage_records
+from .auto_uv import unwrapped_steps
+from .instances import instanced_soups
 from .job_summary import job_summary
 from .view_scene import BAKED_AO_PROPERTY
 
@@ -44,12 +45,14 @@ from .view_scene import BAKED_AO_PROPERTY
 class BakeUnit:
     """One bake of a job: the objects baked together (one, or a texture set's), the label
     its image and files are named after, the Selected-to-Active sources (None: the objects'
-    own surface) and the other meshes that occlude."""
+    own surface), the other meshes that occlude, and whether the scene's mesh instances
+    occlude too (blender/instances.py: with every visible mesh)."""
 
     label: str
     objects: list
     sources: list | None
     occluders: list
+    instanced: bool = False
 
 
 def _with_status(steps: Generator, fraction: float, text: str) -> Generator[tuple[float, str], None, object]:
@@ -88,6 +91,7 @@ class BakeJob:
         self.records: dict[str, tuple[str, BakeResult, SceneState]] = {}
         self.finished = False
         self.unwrap_seconds = 0.0
+        self.unwrap_notes: list[str] = []  # which unwraps fell back to xatlas' own charts (auto_uv.py)
 
     # -- preparation -----------------------------------------------------------------------
     def _uv_name_for(self, obj) -> Generator[tuple[float, str], None, str]:
@@ -103,15 +107,11 @@ class BakeJob:
             return mesh_data.AO_UV_NAME  # ours from an earlier bake: reuse, never re-unwrap
         if mesh.uv_layers:
             return mesh.uv_layers[0].name  # AUTO: the first UV map when there is one
-        positions, tris, tri_loops, polygons = mesh_data.base_mesh_triangles(obj)
-        size = self.request.settings.size
-        unwrap = unwrap_steps(positions, tris, size, name=obj.name, polygons=polygons)
-        t0 = time.perf_counter()
-        uvs = yield from _with_status(unwrap, 0.0, f"Unwrapping '{obj.name}'")
+        t0 = time.perf_counter()  # the maps it adds are removed again if the bake fails
+        unwrap = unwrapped_steps(obj, self.request.settings.size, self.created_uv)
+        new_name, note = yield from relay(unwrap, lambda step: (0.0, step[1]))
         self.unwrap_seconds += time.perf_counter() - t0
-        new_name = mesh_data.add_uv_layer(mesh, mesh_data.AO_UV_NAME, tri_loops, uvs)
-        self.created_uv.append((mesh, new_name))  # removed again if the bake fails
-        check_unwrap_overlap(mesh_data.written_triangle_uvs(mesh, new_name, tri_loops), size, obj.name)
+        self.unwrap_notes += [note] if note else []
         return new_name
 
     def _occluder_objects(self, target) -> list:
@@ -137,12 +137,13 @@ class BakeJob:
         if req.groups is not None:
             return [self._group_unit(group, low) for group in req.groups for low in group.lows]
         skip = set(req.high_poly or ()) | {req.cage}
+        every = req.options.occluders == "visible"
         if req.options.texture_set:
             objects = list(req.targets)
             return [BakeUnit(TEXTURE_SET_NAME, objects, None,
-                             [o for o in self._occluder_objects(objects[0]) if o not in skip | set(objects)])]
-        return [BakeUnit(obj.name, [obj], req.high_poly, [o for o in self._occluder_objects(obj) if o not in skip])
-                for obj in req.targets]
+                             [o for o in self._occluder_objects(objects[0]) if o not in skip | set(objects)], every)]
+        return [BakeUnit(obj.name, [obj], req.high_poly, [o for o in self._occluder_objects(obj) if o not in skip],
+                         every) for obj in req.targets]
 
     def _group_unit(self, group: BakeGroup, low) -> BakeUnit:
         """A low-poly of a bake group. 'group': its own group occludes (the highs, which are
@@ -155,7 +156,8 @@ class BakeJob:
             stand_ins = {o for g in self.request.groups if g.highs for o in g.lows}
             occluders = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()
                          and o not in stand_ins and o != low and o not in (sources or ())]
-        return BakeUnit(TEXTURE_SET_NAME if self.request.options.texture_set else low.name, [low], sources, occluders)
+        return BakeUnit(TEXTURE_SET_NAME if self.request.options.texture_set else low.name, [low], sources, occluders,
+                        self.request.options.group_occluders == "all")
 
     def _high_to_low(self, low, depsgraph, high_poly: list) -> HighToLow:
         """The Selected-to-Active request of the low-poly: its sources (high_poly) with their
@@ -230,6 +232,7 @@ class BakeJob:
         alpha = req.settings.alpha != "off"
         occluders = [mesh_data.evaluated_soup(o, depsgraph, None, shading_normals=False, alpha=alpha,
                                               alpha_size=req.settings.size) for o in unit.occluders]
+        occluders += instanced_soups(depsgraph, alpha, req.settings.size) if unit.instanced else []
         alpha_notes = sorted({note for o in occluders if o.alpha is not None for note in o.alpha.notes})
         return soup, target, occluders, alpha_notes, terminator_settings(req.settings, unit.sources or unit.objects)
 
@@ -259,9 +262,8 @@ class BakeJob:
                                                        f"Baking AO of '{label}'{at} {count}: {frac * 100:.0f}%"))
         result = yield from self._verified(result, target, occluders, settings, label, start + share, at)
         yield from self._make_maps(unit, uv_names, depsgraph, soup, settings, result, start + share, frame)
-        if alpha_notes:
-            result = replace(result, stats={**result.stats,
-                                            "warnings": [*result.stats.get("warnings", []), *alpha_notes]})
+        result = replace(result, stats={**result.stats, "instanced_occluders": len(occluders) - len(unit.occluders),
+                                        "warnings": [*result.stats.get("warnings", []), *alpha_notes]})
         # A texture set's objects share one result (commit writes it once).
         self.results.extend((o, uv_names[o.name], result) for o in objects)
         if key is not None:

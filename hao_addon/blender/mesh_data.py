@@ -14,18 +14,20 @@ AO_UV_NAME = "AO_UV"
 
 
 def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str | None,
-                   shading_normals: bool = True, alpha: bool = False, alpha_size: int = 4096) -> TriangleSoup:
+                   shading_normals: bool = True, alpha: bool = False, alpha_size: int = 4096,
+                   matrix=None, name: str | None = None) -> TriangleSoup:
     """The object's evaluated mesh in world space, with the named UV map (or none) and, when
     asked, the corner shading normals and (alpha) what its materials let through as an
     occluder (blender/material_alpha.py). A mirroring transform (negative determinant) turns
     the triangles inside out; their corners are reordered so faces keep pointing outwards,
     as Blender and Cycles treat mirrored objects. alpha_size: the bake's resolution (alpha
-    textures are read no finer than it can use)."""
-    obj_eval = obj.evaluated_get(depsgraph)
+    textures are read no finer than it can use). matrix, name: an instance's world transform
+    and name (obj then the evaluated object it instances: blender/instances.py)."""
+    obj_eval = obj if matrix is not None else obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
         co, tri_verts, tri_loops = mesh_arrays(mesh)
-        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        m = np.array(obj_eval.matrix_world if matrix is None else matrix, dtype=np.float64)
         linear = m[:3, :3]
         if np.linalg.det(linear) < 0.0:
             tri_verts, tri_loops = tri_verts[:, ::-1], tri_loops[:, ::-1]
@@ -33,6 +35,7 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
         uvs = loop_uvs(mesh, uv_name)[tri_loops] if uv_name else None
         normals = None
         if shading_normals and len(mesh.loops):
+            _normals_at_unit_scale(mesh, co)
             # Normals transform with the inverse transpose (non-uniform scale bends them).
             normal_matrix = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-300 else linear
             normals = corner_normals(mesh)[tri_loops] @ normal_matrix.T
@@ -40,9 +43,25 @@ def evaluated_soup(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_nam
         if alpha:
             from .material_alpha import soup_alpha
             lets_through = soup_alpha(obj, mesh, tri_loops, alpha_size)
-        return TriangleSoup(world[tri_verts], uvs, name=obj.name, normals=normals, alpha=lets_through)
+        return TriangleSoup(world[tri_verts], uvs, name=name or obj.name, normals=normals, alpha=lets_through)
     finally:
         obj_eval.to_mesh_clear()
+
+
+# Blender computes normals in float32 with absolute thresholds: a mesh this small (or this
+# large) gets garbage shading normals (a UV sphere of radius 1e-9: corners up to 169 degrees
+# from their faces, a lone sphere baked down to 0.02 where it must read 1).
+NORMALS_SCALE_RANGE = (1e-3, 1e6)
+
+
+def _normals_at_unit_scale(mesh: bpy.types.Mesh, co: np.ndarray) -> None:
+    """Scale a temporary mesh whose extent lies outside NORMALS_SCALE_RANGE to unit size, so
+    that Blender evaluates its normals where float32 holds them (a uniform scale changes no
+    normal, custom ones included). co: its (V, 3) vertex positions, read before."""
+    extent = float(np.ptp(co, axis=0).max()) if len(co) else 0.0
+    if extent > 0.0 and not NORMALS_SCALE_RANGE[0] <= extent <= NORMALS_SCALE_RANGE[1]:
+        from mathutils import Matrix
+        mesh.transform(Matrix.Diagonal((1.0 / extent,) * 3).to_4x4())
 
 
 def corner_tangents(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph, uv_name: str) -> np.ndarray:

@@ -12,7 +12,8 @@ from .io import check_signals, deferred_signals, load_blender, Progress, REPORT,
 from .options import option_for, settings_from_args
 from .parser import EXTRA_OUTPUT_OPTIONS, IMAGE_OPTIONS, INPUT_FORMATS
 from .scene import (check_gltf_target, check_input, check_json_target, check_mesh_target, export_glb,
-                        export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target)
+                        export_mesh_file, load_scene, MESH_OUT_FORMATS, pick_high_poly, pick_mesh, pick_target,
+                        uv_mesh_path)
 from ..core.bake.map_kinds import EXTRA_MAPS, MAP_KINDS
 from ..core.bake.target_kinds import target_kind
 from ..core.frame_ranges import parse_frames
@@ -72,8 +73,8 @@ def run_bake(args, report: Report, progress: Progress) -> list[str]:
             job = BakeJob(request, bpy.context.evaluated_depsgraph_get)
     start_gpu()
     t0 = time.perf_counter()
-    _bake_and_write(job, run, targets, report, progress)
-    return report.notes + skip_lines + _report_results(job, run, args, report, time.perf_counter() - t0)
+    uv_meshes = _bake_and_write(job, run, targets, report, progress)
+    return report.notes + skip_lines + _report_results(job, run, args, report, time.perf_counter() - t0, uv_meshes)
 
 
 def _checked_run(args, report: Report) -> _Run:
@@ -236,9 +237,10 @@ def _request(args, run: _Run, targets: list, high_poly: list | None, cage, group
                        file_text={BAKE_KEY: run.key})
 
 
-def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Progress) -> None:
+def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Progress) -> list[tuple[str, Path]]:
     """Run the job, then write its maps and the mesh files all or nothing; on any failure or
-    signal nothing of it is left but a sequence's finished frames (listed in the report)."""
+    signal nothing of it is left but a sequence's finished frames (listed in the report).
+    Returns the meshes written with the UV maps the bake made (_write_uv_meshes)."""
     try:
         with report.phase("bake"):
             for fraction, text in job.steps():
@@ -253,24 +255,27 @@ def _bake_and_write(job, run: _Run, targets: list, report: Report, progress: Pro
                 export_mesh_file(targets, run.mesh_out, colors=True)
             if run.gltf_out is not None:
                 export_glb(targets, run.gltf_out)
+            uv_meshes = _write_uv_meshes(job, run, targets)
             job.release()
     except BaseException:
         job.cancel()
         _report_frames(job, report)  # a sequence's finished frames stay, and are listed
         report.kept = job.written_note()
         raise
+    return uv_meshes
 
 
-def _report_results(job, run: _Run, args, report: Report, seconds: float) -> list[str]:
+def _report_results(job, run: _Run, args, report: Report, seconds: float, uv_meshes: list = ()) -> list[str]:
     """The report's objects, outputs and warnings of a finished job; returns its summary lines."""
     from ..blender.bake_request import output_path_for
     from ..blender.color_attributes import AO_ATTRIBUTE
+    from ..blender.mesh_data import AO_UV_NAME
     from ..core.output_files import frame_pattern
 
     request, settings = job.request, run.settings
     report.timings["unwrap"] = round(job.unwrap_seconds, 4)
     report.objects.extend(job.summary())
-    lines = []
+    lines = [f"hao: {note}" for note in job.unwrap_notes]  # an unwrap that fell back to xatlas' own charts
     for obj, label, result in job.baked():
         st = result.stats
         tile_files = job.files.get((label, "ao"), [])
@@ -283,13 +288,16 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
         where = (f"per {'vertex' if settings.color_domain == 'point' else 'face corner'} into colour attribute "
                  f"'{AO_ATTRIBUTE}')" if run.to_colors else f"UV map '{uv_name}') {settings.size}x{settings.size}")
         dest = str(run.mesh_out) if run.to_colors else ", ".join(tile_files) or output_path_for(request, obj)
+        dest = ", ".join([dest] + [path for kind in EXTRA_MAPS for path in job.files.get((label, kind.key), [])])
         frames = ""
         if request.frames:
             reused = sum(e["reused"] for e in job.frame_results)
             frames = f" x {len(request.frames)} frames ({reused} reused, same geometry)"
             dest = frame_pattern(output_path_for(request, obj))
         error = result.error.text() if result.error is not None else f"{settings.directions} directions"
-        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles, {where}, {error}{frames} in "
+        count = st.get("instanced_occluders", 0)
+        instanced = f", {count} instanced occluder{'s' if count > 1 else ''}" if count else ""
+        lines.append(f"hao: baked '{label}' ({st['target_faces']} triangles{instanced}, {where}, {error}{frames} in "
                      f"{seconds:.2f} s -> {dest}")
         if "rebake" in st:  # --rebake-changed: what it re-baked, and the bound on what it kept
             from ..rebake import RebakeReport
@@ -302,9 +310,35 @@ def _report_results(job, run: _Run, args, report: Report, seconds: float) -> lis
                                          f"(95 % from {check.p99[0]:.2g}), above --verify-max-error {bound:g}")
     if run.gltf_out is not None:
         report.outputs.append(str(run.gltf_out))
+    for name, path in uv_meshes:
+        report.outputs.append(str(path))
+        lines.append(f"hao: '{name}' had no UV map: the mesh with the one baked into ('{AO_UV_NAME}') -> {path}")
     if request.frames:
         _report_frames(job, report)
     return lines
+
+
+def _write_uv_meshes(job, run: _Run, targets: list) -> list[tuple[str, Path]]:
+    """(object name, file) of each baked mesh whose UV map the bake made (it had none), written
+    beside its map (scene.uv_mesh_path) so that the map can be applied: those UVs exist
+    nowhere else once this process ends. Not where --gltf-out holds them already, nor for a
+    sequence or a colour attribute."""
+    from ..blender.bake_request import output_path_for
+    if run.gltf_out is not None or run.to_colors or job.request.frames:
+        return []
+    made = {mesh.name for mesh, _name in job.created_uv}
+    written = []
+    try:
+        for obj in targets:
+            if obj.data.name in made:
+                path = uv_mesh_path(output_path_for(job.request, obj), run.source)
+                export_mesh_file([obj], path)
+                written.append((obj.name, path))
+    except BaseException:  # all or nothing: the maps are put back by the caller, these here
+        for _name, path in written:
+            path.unlink(missing_ok=True)
+        raise
+    return written
 
 
 def _report_frames(job, report: Report) -> None:

@@ -166,6 +166,9 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
         if suffix == ".glb":
             extra = {"export_vertex_color": 'ACTIVE'} if colors else {}
             result = bpy.ops.export_scene.gltf(filepath=str(tmp), export_format='GLB', use_selection=True, **extra)
+        elif suffix == ".obj":  # the active UV map: a mesh that had none has only the new one
+            result = bpy.ops.wm.obj_export(filepath=str(tmp), export_selected_objects=True, export_uv=True,
+                                           export_materials=False)
         elif suffix == ".ply":
             result = bpy.ops.wm.ply_export(filepath=str(tmp), export_selected_objects=True,
                                            export_colors='LINEAR' if colors else 'NONE')
@@ -179,6 +182,19 @@ def export_mesh_file(objects: list, path: Path, colors: bool = False) -> None:
         if tmp.exists():
             tmp.unlink()
         remove_made(made)
+
+
+# The mesh file beside a map whose UV map the bake made, by the input's format (else .glb).
+UV_MESH_FORMATS = {".obj": ".obj", ".glb": ".glb", ".gltf": ".glb", ".blend": ".blend"}
+
+
+def uv_mesh_path(map_path: str, source: Path) -> Path:
+    """Where a mesh whose UV map a bake made is written beside its map: the map's name with
+    the input's format (UV_MESH_FORMATS), '_uv' added where that would be the input itself."""
+    path = Path(map_path).with_suffix(UV_MESH_FORMATS.get(source.suffix.lower(), ".glb"))
+    if path.exists() and path.resolve() == source.resolve():
+        path = path.with_name(f"{path.stem}_uv{path.suffix}")
+    return path
 
 
 def export_glb(objects: list, path: Path) -> None:

@@ -88,6 +88,20 @@ def corner_shading_normals(positions: np.ndarray, normals: np.ndarray | None,
     return unit, int(differs.sum())
 
 
+def unusable_normal_warnings(name: str, normals: np.ndarray | None) -> list[str]:
+    """[] or a warning that some of a mesh's (F, 3, 3) corner normals are zero or not finite
+    (corner_shading_normals bakes their faces flat there)."""
+    if normals is None:
+        return []
+    n = np.asarray(normals, np.float64).reshape(-1, 3)
+    length = np.sqrt(np.einsum("ki,ki->k", n, n))
+    bad = int((~np.isfinite(length) | (length <= 1e-12)).sum())
+    if bad == 0:
+        return []
+    return [f"'{name}': {bad} of its {len(n)} shading normals are zero or not finite (a degenerate mesh, or one "
+            f"at an extreme scale): those corners are shaded flat, with their faces' normals"]
+
+
 def smooth_vertex_normals(positions: np.ndarray) -> np.ndarray:
     """(F, 3, 3) corner normals of (F, 3, 3) triangles shaded smooth the way Blender does it:
     at each welded vertex the face normals weighted by the corner angle, normalized."""

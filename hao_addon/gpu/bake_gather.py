@@ -41,7 +41,7 @@ from ..core.bake.receivers import Receivers
 from . import util
 from .gather_difference import SceneBefore, runs_within, window_arrays
 from .gather_texel_list import TexelList, entry_bytes, faces_reaching_cells
-from .light_view import LAYERS, LightViewBaker, depth_prepass, layers_prepass, plan_batch, positions_batch
+from .light_view import LAYERS, LightViewBaker, layer_lists, depth_prepass, layers_prepass, plan_batch, positions_batch
 from .gather_shaders import (ACCUM_FORMATS, ACCUM_NAMES, FORMAT_CHANNELS, GATHER_MAX_VIEWS, GATHER_VIEWS_DTYPE,
                              GROUP_SIZE, LIST_WIDTH, gather_shader)
 
@@ -115,7 +115,7 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
         if self.layered:
             # Max distance: the occluder nearest to each receiver, from per-pixel depth lists.
             self.layer_count = gpu.types.GPUTexture((side, side), format='R32UI')
-            self.layer_depth = gpu.types.GPUTexture((side, side, LAYERS), format='R32UI')
+            self.layer_depth = layer_lists(side)
             self.overflow = gpu.types.GPUTexture((1, 1), format='R32UI')
             self.overflow.clear(format='UINT', value=(0,))
             self.layers_fb = gpu.types.GPUFrameBuffer(color_slots=self.dummy)

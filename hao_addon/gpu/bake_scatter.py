@@ -31,7 +31,7 @@ from ..core.bake.receivers import Receivers, receivers_at
 from ..core.bake.uv_raster import texel_area_points
 from ..core.directions import probe_order
 from . import util
-from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, bind_light_view, depth_prepass, layers_prepass,
+from .light_view import (LAYERS, RASTER_VARYINGS, LightViewBaker, layer_lists, bind_light_view, depth_prepass, layers_prepass,
                          soup_shader_info)
 from .shaders import cached_shader, glsl_source, shader_variants
 
@@ -57,7 +57,7 @@ def _splat_info(uniform: bool, layered: bool, wendland: bool, footprint: bool,
     info.define("MAX_FOOTPRINT", str(MAX_FOOTPRINT if footprint else 1))
     if layered:
         info.image(1, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
-        info.image(2, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+        info.image(2, 'R32UI', 'UINT_2D_ARRAY', "layer_depth", qualifiers={'READ', 'WRITE'})
         info.push_constant('FLOAT', "depth_span")
         info.push_constant('FLOAT', "max_distance")
         info.push_constant('FLOAT', "min_distance")
@@ -150,7 +150,7 @@ class ScatterBaker(LightViewBaker):
         if self.layered:
             # Skip what the scene does not need: only max-distance bakes pay for layer lists.
             self.layer_count = gpu.types.GPUTexture((side, side), format='R32UI')
-            self.layer_depth = gpu.types.GPUTexture((side, side, LAYERS), format='R32UI')
+            self.layer_depth = layer_lists(side)
             self.overflow = gpu.types.GPUTexture((1, 1), format='R32UI')
             self.overflow.clear(format='UINT', value=(0,))
             self.depth = self.depth_fb = None

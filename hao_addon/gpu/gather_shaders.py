@@ -169,7 +169,7 @@ def _gather_info(uniform: bool, views: int, shading: bool, falloff: str | None, 
         if falloff == "wendland":
             info.define("WENDLAND_FALLOFF", "1")
         info.image(3, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ'})
-        info.image(4, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ'})
+        info.image(4, 'R32UI', 'UINT_2D_ARRAY', "layer_depth", qualifiers={'READ'})
         info.push_constant('FLOAT', "max_distance")
         info.push_constant('FLOAT', "min_distance")
     info.compute_source(glsl_source("octahedral.glsl", "bake_falloff.glsl", "bake_terminator.glsl",

@@ -45,10 +45,17 @@ RASTER_VARYINGS = (('smooth', 'VEC2', "uv_texel"), ('smooth', 'VEC4', "face_data
 LAYERS = 16
 
 
+def layer_lists(side: int) -> "gpu.types.GPUTexture":
+    """The (side, side) pixels' depth lists, LAYERS deep: a 2D array texture, whose sides may
+    reach the GPU's 2D limit (a 3D texture's are lower: 2048 on Mesa's OpenGL, where a
+    1024^2 max-distance bake's views of 2053 pixels failed)."""
+    return gpu.types.GPUTexture((side, side), layers=LAYERS, format='R32UI')
+
+
 def _layers_info() -> "gpu.types.GPUShaderCreateInfo":
     info = soup_shader_info("bake_layers", "bake_raster.vert", RASTER_VARYINGS, ('FLOAT', "dummy_out"))
     info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
-    info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+    info.image(1, 'R32UI', 'UINT_2D_ARRAY', "layer_depth", qualifiers={'READ', 'WRITE'})
     info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
     info.define("LAYERS", str(LAYERS))
     info.fragment_source(glsl_source("bake_layers.frag"))
@@ -63,7 +70,7 @@ def layers_shader() -> "gpu.types.GPUShader":
 def layers_prepass(framebuffer, batch, view: OrthoView, culling: str, count, depth, overflow,
                    alpha: tuple[AlphaPass, int] | None = None) -> None:
     """The depth of every fragment of `batch` into per-pixel lists (count (side, side) and
-    depth (side, side, LAYERS) R32UI images; overflow counts pixels with more than LAYERS):
+    depth (side, side) x LAYERS R32UI images (layer_lists); overflow counts pixels with more than LAYERS):
     what max-distance bakes search for the occluder nearest to a receiver. Call inside
     util.scoped_state(); the lists are ready for imageLoad when it returns."""
     count.clear(format='UINT', value=(0,))
@@ -130,7 +137,7 @@ def _alpha_info(fragment: str, layered: bool) -> "gpu.types.GPUShaderCreateInfo"
     info.define("ALPHA")
     if layered:
         info.image(0, 'R32UI', 'UINT_2D', "layer_count", qualifiers={'READ', 'WRITE'})
-        info.image(1, 'R32UI', 'UINT_3D', "layer_depth", qualifiers={'READ', 'WRITE'})
+        info.image(1, 'R32UI', 'UINT_2D_ARRAY', "layer_depth", qualifiers={'READ', 'WRITE'})
         info.image(2, 'R32UI', 'UINT_2D', "overflow", qualifiers={'READ', 'WRITE'})
         info.define("LAYERS", str(LAYERS))
     info.vertex_source(glsl_source("bake_alpha.vert"))

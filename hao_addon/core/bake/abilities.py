@@ -53,7 +53,10 @@ class BakerDeclaration:
     bakes only those. floor_unchecked: why the bake's visibility floor is not measured
     (hao_addon/floor_check.py: exact rays at sampled texels along its own directions); '' when it is.
     crops_views: its light views can be cropped to spheres (BakeRun.window_spheres), a
-    receiver outside reading lit: a re-bake by difference (hao_addon/rebake_difference.py)."""
+    receiver outside reading lit: a re-bake by difference (hao_addon/rebake_difference.py).
+    traces_contacts: its visibility test misses occluders nearer than its depth slack, so the
+    receivers in contact with another surface (core/bake/contacts.py) are traced exactly
+    (hao_addon/contact_repair.py)."""
 
     method: str
     label: str
@@ -63,6 +66,7 @@ class BakerDeclaration:
     bakes_all_cells: str = ""
     floor_unchecked: str = ""
     crops_views: bool = False
+    traces_contacts: bool = False
 
     def can(self, ability: str) -> bool:
         return ability not in self.cannot
@@ -82,7 +86,7 @@ BAKERS = (
                 "color-attribute": "it rasterizes the UV layout"},
         bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
     BakerDeclaration(
-        "gather", "shadow-map gather", gpu=True, crops_views=True,
+        "gather", "shadow-map gather", gpu=True, crops_views=True, traces_contacts=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "
                              "walls: 0.006 too thin on a ball, measured by tests/test_thickness.py"}),
     BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False,

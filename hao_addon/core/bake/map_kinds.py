@@ -76,7 +76,8 @@ MAP_KINDS = (
                     "Active)"),
     MapKind("orm", "orm", "the ORM texture", 4, "", "orm_file", "Save ORM To",
             "glTF's occlusion-roughness-metallic texture: R the AO, G and B the material's roughness and "
-            "metallic (values or image textures) in the baked UV layout",
+            "metallic (values or image textures) in the baked UV layout (past the islands' margin, each "
+            "channel's mean over them)",
             "with --gltf-out the .glb's material uses it for occlusion, roughness and metallic", image_suffix="ORM",
             target_kinds=IMAGE_KINDS, refusal="the ORM texture packs one object's AO with its material (not a colour "
                                               "attribute)"),

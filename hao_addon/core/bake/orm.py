@@ -20,13 +20,16 @@ def sample_nearest(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
 def channel_map(uvs: np.ndarray, size: int, face_value, margin: int) -> np.ndarray:
     """(size, size) float32 of a surface channel in a UV layout uvs (F, 3, 2): at each texel
     centre, face_value(face (m,), bary (m, 3)) -> (m,) of the triangle holding it; grown past
-    the islands by margin texels (as the AO map is), 0 beyond."""
+    the islands by margin texels (as the AO map is), and beyond that the channel's mean over
+    the islands: a defined, neutral value that a mipmap's coarse levels blend in (0 there made
+    an ORM texture pure red outside its islands: roughness 0, a mirror)."""
     face, bary, hits = texel_surface_samples(uvs, size)
     covered = face >= 0
     values = np.zeros((size, size), np.float32)
     values[covered] = face_value(face[covered], bary[covered])
     grown, filled = dilate(values, covered, margin + 2)
-    return np.where(filled, grown, 0.0).astype(np.float32)
+    background = float(values[covered].mean()) if covered.any() else 0.0
+    return np.where(filled, grown, background).astype(np.float32)
 
 
 def orm_image(ao: np.ndarray, roughness: np.ndarray, metallic: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ import numpy as np
 from ..directions import bake_directions
 from ..errors import BakeInputError
 from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
-                        surface_holes, uv_areas, weld)
+                        surface_holes, unusable_normal_warnings, uv_areas, weld)
 from .abilities import abilities_needed, check_method, choose_method, declaration
 from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
@@ -308,7 +308,9 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         method = choose_method(run.method, _needs(settings, run, kind, udim) | {"alpha"})
     holes = _drawn_holes(settings, alpha, drawn, target_weld if len(o_pos) == 0 else None)
     stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
-                        holes, smooth_corners, uv_warnings + layout.warnings, alpha, {**uv_counters, **layout.counters})
+                        holes, smooth_corners, uv_warnings + layout.warnings + unusable_normal_warnings(
+                            target.name, target.normals if settings.normals == "mesh" else None),
+                        alpha, {**uv_counters, **layout.counters})
     uvs = np.zeros((target.face_count, 3, 2)) if target.uvs is None else target.uvs
     # A view's side is at most the diameter of the whole target (extent about the origin); a
     # run of some cells draws a window of such views (views.fit_views).

@@ -18,9 +18,10 @@ from typing import ClassVar, Generator
 
 import numpy as np
 
+from .contacts import contact_faces
 from .estimators import BENT_NORMALS, Estimator
 from .projection import RayCast, projected_receivers_steps
-from .receivers import Receivers, corner_receivers, uv_receivers
+from .receivers import Receivers, corner_receivers, receivers_at, tiled_sample_points, uv_receivers
 from .seams import element_values, estimated, finalize_map, finalize_vectors
 from .settings import BakeSettings
 from .target_kinds import TARGET_KINDS
@@ -111,6 +112,22 @@ class TexelLayout:
         names them (only the faces reaching them rasterized)."""
         return uv_receivers(plan.target_positions, plan.target_uvs, plan.target_faces, plan.target_corners,
                             self.size, self.sample_count, plan.lifts_terminator, self.udim, plan.cells)
+
+    def contact_candidates(self, plan, reach: float) -> tuple[Receivers, np.ndarray]:
+        """(receivers, faces): receivers of `plan` that may be in contact with a drawn face
+        within `reach` (core/bake/contacts.py), and the drawn faces they may be in contact
+        with (indices into plan.drawn_positions): those on the target's faces that can be
+        (only those faces rasterized: where UV islands overlap, a texel's point may lie on
+        another face than in the whole raster)."""
+        faces, partners = contact_faces(plan.target_positions, plan.drawn_positions, reach)
+        if self.udim is None:
+            texel, face, bary = tiled_sample_points(plan.target_uvs[faces], self.size, self.sample_count)
+            face = faces[face]
+        else:  # the tiles know the faces by their index in the whole target: all of them, then those
+            texel, face, bary = tiled_sample_points(plan.target_uvs, self.size, self.sample_count, self.udim)
+            keep = np.isin(face, faces)
+            texel, face, bary = texel[keep], face[keep], bary[keep]
+        return receivers_at(plan.target_positions, plan.target_faces, plan.target_corners, texel, face, bary), partners
 
     def receiver_bound(self) -> int:
         """The most receivers a whole bake has (a reference bake's rays per direction)."""
@@ -213,6 +230,10 @@ class ProjectedLayout(TexelLayout):
     def receivers(self, plan) -> Receivers:
         return self.projected
 
+    def contact_candidates(self, plan, reach: float) -> tuple[Receivers, np.ndarray]:
+        # Points of the high-poly sources, not of the target's faces: all of them, every face.
+        return self.projected, np.arange(len(plan.drawn_positions))
+
     def receiver_bound(self) -> int:
         return len(self.projected)
 
@@ -248,6 +269,9 @@ class CornerLayout(TexelLayout):
     def counters(self) -> dict:
         return dict(vertex_target_corners=int((self.corners.cells >= 0).sum()),
                     vertex_target_elements=self.corners.count)
+
+    def contact_candidates(self, plan, reach: float) -> tuple[Receivers, np.ndarray]:
+        return self.receivers(plan), np.arange(len(plan.drawn_positions))  # a few per face: all of them
 
     def receivers(self, plan) -> Receivers:
         return corner_receivers(plan.target_faces, plan.target_positions, plan.target_corners, self.corners.cells,

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import BakeInputError
 from ..steps import drain
 from .charts import overlapping_texels
-from .unwrap_worker import atlas_uvs
+from .unwrap_worker import UNWRAPS
 
 # xatlas' padding around each chart, in texels of the texture, on top of its one-texel
 # bilinear border and conservative rasterization: with 1, at least three texels lie clear
@@ -84,15 +84,16 @@ def unit_copy(vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -
 
 def unwrap_in_process(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
                       padding: int = DEFAULT_PADDING, name: str = "mesh",
-                      polygons: np.ndarray | None = None) -> np.ndarray:
+                      polygons: np.ndarray | None = None, way: str = "charts") -> np.ndarray:
     """Per-corner UVs (F, 3, 2) float64 in [0, 1], in this process (blocks until done).
 
     vertices: (V, 3) float, any scale and offset; triangles: (F, 3) int vertex indices;
     resolution: the texture size the atlas is packed for; polygons: (F,) each triangle's
-    polygon (a polygon's triangles land in one chart) or None."""
+    polygon (a polygon's triangles land in one chart) or None; way: 'charts' (planar charts
+    packed by xatlas) or 'xatlas' (xatlas' own charts: the fallback, unwrap_worker.UNWRAPS)."""
     unit = unit_copy(vertices, triangles, name)
     try:
-        return atlas_uvs(unit, np.asarray(triangles, np.uint32), resolution, padding, polygons)
+        return UNWRAPS[way](unit, np.asarray(triangles, np.uint32), resolution, padding, polygons)
     except RuntimeError as exc:
         raise UnwrapError(f"cannot unwrap '{name}': {exc}") from None
 
@@ -108,7 +109,7 @@ def worker_python() -> str | None:
 
 def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
                  padding: int = DEFAULT_PADDING, name: str = "mesh",
-                 polygons: np.ndarray | None = None) -> Generator[None, None, np.ndarray]:
+                 polygons: np.ndarray | None = None, way: str = "charts") -> Generator[None, None, np.ndarray]:
     """Like unwrap_in_process, in a child process: yields while it runs (poll, report progress,
     or close the generator to kill it), returns the UVs (F, 3, 2).
 
@@ -118,14 +119,14 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
     python = worker_python()
     if python is None:
         yield
-        return unwrap_in_process(unit, triangles, resolution, padding, name, polygons)
+        return unwrap_in_process(unit, triangles, resolution, padding, name, polygons, way)
     folder = tempfile.mkdtemp(prefix="hao-unwrap-")
     proc = None
     try:
         source, target = os.path.join(folder, "in.npz"), os.path.join(folder, "out.npy")
         extra = {} if polygons is None else {"polygons": np.asarray(polygons, np.int64)}
         np.savez(source, vertices=unit, triangles=np.asarray(triangles, np.uint32),
-                 resolution=np.int64(resolution), padding=np.int64(padding), **extra)
+                 resolution=np.int64(resolution), padding=np.int64(padding), way=np.str_(way), **extra)
         env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
         with open(os.path.join(folder, "err.txt"), "wb") as err:
             proc = subprocess.Popen([python, str(WORKER), source, target], stdin=subprocess.DEVNULL,
@@ -145,6 +146,7 @@ def unwrap_steps(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
 
 
 def run_unwrap(vertices: np.ndarray, triangles: np.ndarray, resolution: int,
-               padding: int = DEFAULT_PADDING, name: str = "mesh", polygons: np.ndarray | None = None) -> np.ndarray:
+               padding: int = DEFAULT_PADDING, name: str = "mesh", polygons: np.ndarray | None = None,
+               way: str = "charts") -> np.ndarray:
     """Blocking unwrap in a child process (interruptible); returns (F, 3, 2) UVs."""
-    return drain(unwrap_steps(vertices, triangles, resolution, padding, name, polygons))
+    return drain(unwrap_steps(vertices, triangles, resolution, padding, name, polygons, way))
