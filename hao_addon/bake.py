@@ -26,7 +26,7 @@ from .core.bake.projection import HighToLow
 from .core.bake.error_estimate import ErrorEstimate, converged, estimate, local_rms, next_round, PILOT_DIRECTIONS, \
     replicate_twin, with_floor, directions_for
 from .contact_repair import traced_contacts_steps
-from .floor_check import floor_sample, floor_steps, probe_steps, take_probe
+from .floor_check import FLOOR_REACH, floor_sample, floor_steps, floor_warnings, probe_steps, take_probe
 from .replicates import replicate_sums_steps
 from .core.bake.seams import dilate, finalize_vectors
 from .core.bake.settings import QUALITY_CAPS, BakeSettings
@@ -83,10 +83,6 @@ SKIP_CONVERGED = False
 # The share of a GPU bake's progress bar that measuring its visibility floor fills (a few
 # percent of its time: hao_addon/floor_check.py).
 FLOOR_PROGRESS_SHARE = 0.05
-
-# A bake to an error whose visibility floor has a p99 above this share of its target stops
-# adding directions: they cannot bring it there (the report says so, and what to raise).
-FLOOR_REACH = 0.9
 
 # The share of a Selected-to-Active bake's progress bar that its projection fills (measured on
 # the bunny pair at 1024^2: 2.8 s of 7.8 s at 256 directions, of 22 s at 1024).
@@ -386,16 +382,9 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
         return result
     cells, floor_a, floor_b, weight = found
     error = with_floor(result.error, floor_a, floor_b, result.error_map().reshape(-1)[cells], weight)
-    stats = {**result.stats, "error": error.as_dict()}
-    target = settings.error_target
-    if target > 0.0 and error.p99 > target and not error.capped:
-        why = (f"its visibility floor ({error.floor_p99:.2g} p99) does not fall with directions; raise View "
-               f"Samples or bake with the reference" if error.floor_p99 >= FLOOR_REACH * target else
-               f"with its visibility floor ({error.floor_p99:.2g} p99) it landed above; raise the target or "
-               f"bake again with a larger Quality")
-        stats["warnings"] = [*stats.get("warnings", []),
-                             f"'{name}': the p99 error {error.p99:.2g} is above the target {target:.2g}: {why}"]
-    return replace(result, error=error, stats=stats)
+    warnings = floor_warnings(name, result.error, error, settings.error_target, (floor_a, floor_b))
+    return replace(result, error=error, stats={**result.stats, "error": error.as_dict(),
+                                               "warnings": [*result.stats.get("warnings", []), *warnings]})
 
 
 def _combine_rounds(rounds: list[tuple[int, BakeResult]], margin: int) -> BakeResult:

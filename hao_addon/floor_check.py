@@ -73,6 +73,36 @@ START_OFFSET_PIXELS = 1.0 / 128.0
 REFINED_SHARE = 1.0 / 16.0
 
 
+# A bake to an error whose visibility floor has a p99 above this share of its target stops
+# adding directions: they cannot bring it there (the report says so, and what to raise).
+FLOOR_REACH = 0.9
+# A floor this many times the direction noise (and above FLOOR_NOTICED RMSE) is said, with
+# the share of the checked texels it lies in: what the light views cannot resolve.
+FLOOR_OVER_NOISE = 2.0
+FLOOR_NOTICED = 0.005
+FLOOR_TEXEL = 0.05  # a checked texel holds the floor where both replicates are this far off
+
+
+def floor_warnings(name: str, twins, whole, target: float, floors: tuple[np.ndarray, np.ndarray]) -> list[str]:
+    """The warnings of a bake's whole error `whole` (with_floor of the twins' `twins`; each an
+    ErrorEstimate) against its target (0: none), given the checked texels' floors (floor_a,
+    floor_b): a floor far above the direction noise, where it lies; a target missed, why."""
+    out = []
+    if whole.floor_rmse > max(FLOOR_OVER_NOISE * twins.rmse, FLOOR_NOTICED):
+        share = float(np.mean(np.minimum(np.abs(floors[0]), np.abs(floors[1])) > FLOOR_TEXEL))
+        out.append(f"'{name}': its visibility floor ({whole.floor_rmse:.2g} RMSE) is {whole.floor_rmse / twins.rmse:.2g}x "
+                   f"its direction noise, in {100.0 * share:.2g} % of its texels: surfaces nearer each other or thinner "
+                   f"than a light-view pixel; more directions will not lower it: raise View Samples or bake with the "
+                   f"reference")
+    if target > 0.0 and whole.p99 > target and not whole.capped:
+        why = (f"its visibility floor ({whole.floor_p99:.2g} p99) does not fall with directions; raise View "
+               f"Samples or bake with the reference" if whole.floor_p99 >= FLOOR_REACH * target else
+               f"with its visibility floor ({whole.floor_p99:.2g} p99) it landed above; raise the target or "
+               f"bake again with a larger Quality")
+        out.append(f"'{name}': the p99 error {whole.p99:.2g} is above the target {target:.2g}: {why}")
+    return out
+
+
 @dataclass
 class FloorProbe:
     """A round's partial sums at the sample: plan: the round's; half: directions per

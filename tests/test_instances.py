@@ -70,3 +70,29 @@ def test_a_collection_instance_occludes_as_its_mesh_does(scene):
     # The floor is 4 units wide over 64 texels: the darkest texel moved 1.2 units (about 19 texels) in x.
     row = direct.ao[32]
     assert abs(int(np.argmin(nested.ao[32])) - int(np.argmin(row)) - round(1.2 / 4.0 * 64)) <= 2
+
+
+def test_occluders_are_what_renders_as_in_cycles(scene):
+    """Cycles' bake takes what renders: a mesh hidden in the viewport (the eye) still occludes,
+    one disabled in renders (itself or its collection) does not; before, the opposite."""
+    floor_obj = soup_to_object(scenes.grid_plane(4.0, 4, name="floor"), "floor")
+    cube = soup_to_object(scenes.box((-0.5, -0.5, 0.0), (0.5, 0.5, 1.0), name="cube"), "cube", uv=False)
+    _job, shown = _bake_floor(scene, floor_obj)
+    cube.hide_set(True)
+    _job, eye_hidden = _bake_floor(scene, floor_obj)
+    assert np.array_equal(shown.ao, eye_hidden.ao) and shown.ao.min() < 0.5
+    cube.hide_set(False)
+    cube.hide_render = True
+    _job, not_rendered = _bake_floor(scene, floor_obj)
+    assert not_rendered.ao[not_rendered.covered].min() > 0.999
+    cube.hide_render = False
+    props = _hidden_collection("props", cube)
+    bpy.context.view_layer.layer_collection.children["props"].exclude = False
+    props.hide_render = True
+    _job, collection_off = _bake_floor(scene, floor_obj)
+    assert collection_off.ao[collection_off.covered].min() > 0.999
+    crate = _instance("crate_here", props)  # an instance of what does not render does not either
+    props.hide_render, cube.hide_render = False, True
+    bpy.context.view_layer.layer_collection.children["props"].exclude = True
+    _job, instanced_off = _bake_floor(scene, floor_obj)
+    assert instanced_off.stats["instanced_occluders"] == 0 and crate.name == "crate_here"

@@ -38,6 +38,7 @@ from .map_producers import bent_normal_image, orm_map, surface_maps
 from .rebake_records import keeps_records, recorded_steps, remember_records, stage_records
 from .auto_uv import unwrapped_steps
 from .instances import instanced_soups
+from .visibility import rendered_meshes
 from .job_summary import job_summary
 from .view_scene import BAKED_AO_PROPERTY
 
@@ -122,7 +123,7 @@ class BakeJob:
             candidates = [o for o in self.request.targets if o != target]
             candidates += [o for o in bpy.context.selected_objects if o.type == 'MESH' and o not in candidates]
         else:
-            candidates = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()]
+            candidates = rendered_meshes(bpy.context.view_layer, bpy.context.scene)
         seen, out = set(), []
         for o in candidates:
             if o != target and o.name not in seen:
@@ -154,8 +155,8 @@ class BakeJob:
             occluders = [] if sources else [o for o in group.lows if o != low]
         else:
             stand_ins = {o for g in self.request.groups if g.highs for o in g.lows}
-            occluders = [o for o in bpy.context.view_layer.objects if o.type == 'MESH' and o.visible_get()
-                         and o not in stand_ins and o != low and o not in (sources or ())]
+            occluders = [o for o in rendered_meshes(bpy.context.view_layer, bpy.context.scene)
+                         if o not in stand_ins and o != low and o not in (sources or ())]
         return BakeUnit(TEXTURE_SET_NAME if self.request.options.texture_set else low.name, [low], sources, occluders,
                         self.request.options.group_occluders == "all")
 

@@ -21,6 +21,8 @@ def instanced_soups(depsgraph: bpy.types.Depsgraph, alpha: bool = False, alpha_s
     for instance in depsgraph.object_instances:
         if not instance.is_instance or instance.object.type != 'MESH':
             continue
+        if instance.object.original.hide_render or (instance.parent is not None and instance.parent.original.hide_render):
+            continue  # what does not render does not occlude (blender/visibility.py)
         parent = instance.parent.name if instance.parent is not None else "instance"
         soups.append(mesh_data.evaluated_soup(instance.object, depsgraph, None, shading_normals=False, alpha=alpha,
                                               alpha_size=alpha_size, matrix=instance.matrix_world,

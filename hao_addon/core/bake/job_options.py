@@ -25,8 +25,9 @@ PNG_BITS_CHOICES = (
 OCCLUDER_CHOICES = (
     Choice("target", "Self", "only the baked mesh itself (Selected to Active: the high-poly only)"),
     Choice("selected", "Selected", "the baked mesh and the other selected meshes"),
-    Choice("visible", "Visible", "every visible mesh in the view layer, and the meshes it shows through instances "
-                                 "(collections, geometry nodes, particles)"),
+    Choice("visible", "Visible", "every mesh that renders, as in Cycles' bake (Disable in Renders leaves one out, "
+                                 "hiding it in the viewport does not), and the meshes the scene shows through "
+                                 "instances (collections, geometry nodes, particles)"),
 )
 
 
