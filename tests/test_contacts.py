@@ -120,3 +120,23 @@ def test_a_floor_far_above_the_direction_noise_is_said(gpu_context, monkeypatch)
     said = [w for w in missed.stats["warnings"] if "visibility floor" in w]
     assert missed.error.floor_rmse > 0.1 and len(said) == 1, missed.stats["warnings"]
     assert "x its direction noise, in" in said[0] and "raise View Samples or bake with the reference" in said[0]
+
+
+@pytest.mark.parametrize("grid", [1, 2])
+def test_window_samples_hold_every_sample_point_inside_the_box(grid):
+    """The windowed raster (what contact detection tests, instead of a whole floor's million
+    texels) holds every sample point of the whole raster that lies in the box, with the same
+    face and barycentrics, and few others."""
+    from hao_addon.core.bake.contacts import window_samples
+    from hao_addon.core.bake.receivers import texel_sample_points
+    floor = scenes.grid_plane(8.0, 1)
+    lo, hi = np.array([[0.3, -1.2, -0.05]] * 2), np.array([[1.1, -0.4, 0.05]] * 2)
+    texel, face, bary = window_samples(floor.positions, floor.uvs, np.array([0, 1]), lo, hi, 128, grid)
+    all_texel, all_face, all_bary = texel_sample_points(floor.uvs, 128, grid * grid)
+    points = np.einsum("mk,mkd->md", all_bary, floor.positions[all_face])
+    inside = ((points >= lo[0]) & (points <= hi[0])).all(axis=1)
+    ours = {(t, f): b for t, f, b in zip(texel, face, np.round(bary, 9))}
+    wanted = {(t, f): b for t, f, b in zip(all_texel[inside], all_face[inside], np.round(all_bary[inside], 9))}
+    assert wanted and set(wanted) <= set(ours)
+    assert all(np.array_equal(ours[key], wanted[key]) for key in wanted)
+    assert len(ours) < 2 * len(wanted) + 4 * 128 * grid  # the window, not the floor

@@ -18,10 +18,10 @@ from typing import ClassVar, Generator
 
 import numpy as np
 
-from .contacts import contact_faces
+from .contacts import contact_faces, contact_pairs, window_samples
 from .estimators import BENT_NORMALS, Estimator
 from .projection import RayCast, projected_receivers_steps
-from .receivers import Receivers, corner_receivers, receivers_at, tiled_sample_points, uv_receivers
+from .receivers import Receivers, corner_receivers, receivers_at, sub_texel_grid, tiled_sample_points, uv_receivers
 from .seams import element_values, estimated, finalize_map, finalize_vectors
 from .settings import BakeSettings
 from .target_kinds import TARGET_KINDS
@@ -119,11 +119,14 @@ class TexelLayout:
         with (indices into plan.drawn_positions): those on the target's faces that can be
         (only those faces rasterized: where UV islands overlap, a texel's point may lie on
         another face than in the whole raster)."""
-        faces, partners = contact_faces(plan.target_positions, plan.drawn_positions, reach)
-        if self.udim is None:
-            texel, face, bary = tiled_sample_points(plan.target_uvs[faces], self.size, self.sample_count)
-            face = faces[face]
+        if self.udim is None:  # only the UV windows of the faces near each partner (contacts.window_samples)
+            f, g = contact_pairs(plan.target_positions, plan.drawn_positions, reach)
+            drawn = plan.drawn_positions[g]
+            texel, face, bary = window_samples(plan.target_positions, plan.target_uvs, f, drawn.min(1) - reach,
+                                               drawn.max(1) + reach, self.size, sub_texel_grid(self.sample_count))
+            partners = np.unique(g)
         else:  # the tiles know the faces by their index in the whole target: all of them, then those
+            faces, partners = contact_faces(plan.target_positions, plan.drawn_positions, reach)
             texel, face, bary = tiled_sample_points(plan.target_uvs, self.size, self.sample_count, self.udim)
             keep = np.isin(face, faces)
             texel, face, bary = texel[keep], face[keep], bary[keep]
