@@ -11,6 +11,7 @@ from conftest import DATA, select_only, small_settings, soup_to_object
 from hao_addon.blender import auto_uv, mesh_data
 from hao_addon.core import scenes
 from hao_addon.core.bake.charts import overlapping_texels
+from hao_addon.core.steps import drain
 
 
 def _bake(scene, obj, size: int):
@@ -72,16 +73,8 @@ def test_every_mesh_of_the_repository_unwraps_without_overlap_as_written(scene, 
         while obj.data.uv_layers:
             obj.data.uv_layers.remove(obj.data.uv_layers[0])
         created = []
-        uv_name, note = _drained(auto_uv.unwrapped_steps(obj, size, created))
+        uv_name, note = drain(auto_uv.unwrapped_steps(obj, size, created))
         assert uv_name == mesh_data.AO_UV_NAME and note == "" and created == [(obj.data, uv_name)]
         _positions, _tris, tri_loops, _polygons = mesh_data.base_mesh_triangles(obj)
         overlap, covered = overlapping_texels(mesh_data.written_triangle_uvs(obj.data, uv_name, tri_loops), size)
         assert overlap == 0 and covered > 0.3 * size * size, (obj.name, overlap, covered)
-
-
-def _drained(steps):
-    while True:
-        try:
-            next(steps)
-        except StopIteration as done:
-            return done.value
