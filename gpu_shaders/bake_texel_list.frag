@@ -31,6 +31,11 @@ void main()
 #else
   int entry_bin = face_bin;
 #endif
+#ifdef INTERLEAVE_SIDE
+  /* Each texel class's bins follow the one before's (core/bake/interleave.texel_classes). */
+  ivec2 texel = ivec2(gl_FragCoord.xy);
+  entry_bin += BIN_COUNT * ((texel.x % INTERLEAVE_SIDE) + INTERLEAVE_SIDE * (texel.y % INTERLEAVE_SIDE));
+#endif
   uint index = imageAtomicAdd(bin_count, ivec2(entry_bin, 0), 1u);
 #ifdef FILL
   index += floatBitsToUint(imageLoad(bin_start, ivec2(entry_bin, 0)).r);

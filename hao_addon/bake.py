@@ -247,8 +247,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
             # does not have (the rocker arm at 128^2, 1024 directions: 0.0083 where 0.0065 is
             # measured in all).
             checked = plan.layout.estimated(plan.estimator.ratio(sums)[1])
-            shared["floor_sample"] = floor_sample(method, checked, baker, shared.get("floor_directions", count),
-                                                  plan.seed)
+            shared["floor_sample"] = floor_sample(method, checked, baker,
+                                                  shared.get("floor_directions", plan.texel_directions), plan.seed)
         if snapshots is not None and shared["floor_sample"] is not None:
             shared["floor_probe"] = take_probe(plan, baker, count, snapshots, shared["floor_sample"].cells,
                                                (sums_b if sums_a is None else sums_a, sums_b))
@@ -261,7 +261,7 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
     else:
         ao, covered, filled, bent = plan.layout.finished_cells(plan.estimator, sums, plan.cells)
     twin = None if sums_a is None else _twin(plan, sums_a, sums_b, covered)
-    error = None if twin is None else estimate(twin, covered, count)
+    error = None if twin is None else estimate(twin, covered, plan.texel_directions)
     if not covered.any() and not plan.layout.per_element:
         # A map of no texel is not a bake: a success here would hand back an empty image.
         raise BakeInputError(f"'{target.name}': no texel centre of the {settings.size}x{settings.size} map lies "
@@ -375,8 +375,10 @@ def _with_floor_steps(result: BakeResult, shared: dict, settings: BakeSettings, 
         return result
     probe = shared["floor_probe"]
     if shared.get("floor_found", (None,))[0] is not probe:  # a bake to an error measures it once per probe
+        from .bakers import distance_cast_for  # deferred: the GPU's cast needs a context
         shared["floor_found"] = (probe, (yield from floor_steps(probe, shared["floor_sample"], result.error.directions,
-                                                                 shared.get("contact_cells", ()))))
+                                                                 shared.get("contact_cells", ()),
+                                                                 distance_cast_for(result.method))))
     found = shared["floor_found"][1]
     if found is None:
         return result

@@ -49,3 +49,15 @@ def ray_caster_for(method: str):
     ensure_gpu_context()
     from .gpu.bake_ray_cast import project_steps
     return project_steps
+
+
+def distance_cast_for(method: str):
+    """The batched first-hit cast (core/bake/projection.DistanceCast) that exact rays
+    checking or repairing a `method` bake use: the GPU's grid walk (gpu/bake_ray_cast.py) for
+    the GPU bakers, None (mathutils' BVH, a ray at a time) for the reference."""
+    if ray_cast_name(method) == "cpu":
+        return None
+    from .gpu.context import ensure_gpu_context
+    ensure_gpu_context()
+    from .gpu.bake_ray_cast import first_hit_distances
+    return first_hit_distances

@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Contacts traced exactly: the texels in contact with another surface (core/bake/contacts.py),
 where a baker's depth slack hides what touches them (abilities.traces_contacts: the gather),
-get the CPU reference's sums along the bake's own directions, replicate by replicate, in
-place of the baker's. No Blender data: numpy in and out, as hao_addon.bake.
+get the reference's sums along the bake's own directions, replicate by replicate, in place of
+the baker's: exact rays, each replicate's cast together by the GPU's grid walk
+(bakers.distance_cast_for; a Python call per ray on the CPU was host time no GPU shrinks). No
+Blender data: numpy in and out, as hao_addon.bake.
 
 Why exact rays and not a finer depth map: the gap under a prop resting on a floor goes to 0,
 so no light-view resolution resolves it, and the texels it concerns are few (a band about
@@ -72,23 +74,22 @@ def _traced_steps(plan: BakePlan, cells: np.ndarray, order: np.ndarray, count: i
     in place) at `cells` by the CPU reference's along the same directions (order: the baker's
     direction of each step; the first replicate_sizes(count)[0] steps are the first
     replicate). Yields progress in [0, 1]; returns the counters."""
-    from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
+    from .bakers import distance_cast_for  # deferred: mathutils comes with bpy, the GPU's with a context
+    from .core.bake.reference_baker import ReferenceBaker
     split = replicate_sizes(count)[0] if sums[0] is not None else 0
     # Every direction of each replicate: the texel's noise is the map's (the twins state it),
     # and no band of other noise marks the contacts.
     parts = [(sums[0], order[:split]), (sums[1], order[split:count])] if sums[0] is not None else [(sums[1], order[:count])]
     # A GPU's float32 points start off the surface as the floor check's do.
     baker = ReferenceBaker(plan.with_cells(cells), receivers, START_OFFSET_PIXELS * plan.pixel_size)
+    cast = distance_cast_for(plan.method)  # a replicate's rays at once: the GPU's grid walk
     channels = plan.estimator.channel_count
-    done = 0
     try:
         for k, (part, steps) in enumerate(parts):
             if k:
                 baker.restart()
-            for index in steps:
-                baker.run_direction(int(index))
-                done += 1
-                yield done / count
+            baker.run_directions(steps, cast)
+            yield (k + 1) / len(parts)
             part.reshape(-1, channels)[cells] = baker.accumulated().reshape(-1, channels)[cells]
     finally:
         baker.free()

@@ -36,6 +36,7 @@ import numpy as np
 
 from .core.bake.abilities import declaration
 from .core.bake.plan import BakePlan
+from .core.bake.projection import DistanceCast
 from .core.bake.probe_snapshot import sums_value
 from .core.bake.receivers import Receivers
 from .core.bake.verify import pick_cells
@@ -233,11 +234,12 @@ def refined_count(checked: int, probe: FloorProbe, directions: int) -> int:
     """How many of `checked` texels are checked again along all their round's directions:
     REFINED_SHARE of them, at most as many as the probe's rays buy again."""
     rays = min(FLOOR_RAYS_PER_DIRECTION * directions, FLOOR_RAYS_MAX)
-    per_texel = sum(len(steps) for steps in probe.full_steps)
+    per_texel = sum(len(steps) for steps in probe.full_steps) // probe.plan.classes  # a texel's class's alone
     return int(min(math.ceil(checked * REFINED_SHARE), rays // max(per_texel, 1)))
 
 
-def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_cells: np.ndarray = ()
+def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_cells: np.ndarray = (),
+                cast: DistanceCast | None = None
                 ) -> Generator[float, None, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None]:
     """(cells (n,), floor_a (n,), floor_b (n,), weight (n,)): each replicate's partial value
     minus the reference's along the same directions from the same points, at
@@ -247,7 +249,8 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_c
     reference's along all its directions; weight: the share of the covered texels each stands
     for (FloorSample.weights). None where no cell is lit in both. exact_cells: cells the bake
     traced exactly after its probe (hao_addon/contact_repair.py): in the sample with a floor of
-    0, not traced again. Yields progress in [0, 1]."""
+    0, not traced again. cast: how a replicate's exact rays are cast together (bakers.distance_cast_for;
+    None: one at a time by the CPU's BVH). Yields progress in [0, 1]."""
     values, full_values = probe.values, probe.full_values
     wanted = floor_texel_count(directions)
     keep = sample.thinning(wanted, np.random.default_rng([directions, FLOOR_SEED]))
@@ -259,7 +262,7 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_c
     exact = np.array(values, np.float64)  # a cell traced exactly: its floor is 0
     exact[:, untraced] = yield from relay(
         _exact_steps(probe.plan, cells[untraced], tuple(r.subset(np.isin(r.texel, cells[untraced])) for r in receivers),
-                     probe.steps), lambda f: 0.5 * f)
+                     probe.steps, cast), lambda f: 0.5 * f)
     seen = np.isfinite(exact).all(axis=0) & np.isfinite(values).all(axis=0)
     if not seen.any():
         return None
@@ -269,7 +272,7 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_c
     refined = np.sort(refined[seen[refined] & ~traced[refined]])
     if len(refined):
         subset = tuple(r.subset(np.isin(r.texel, cells[refined])) for r in receivers)
-        exact_all = yield from relay(_exact_steps(probe.plan, cells[refined], subset, probe.full_steps),
+        exact_all = yield from relay(_exact_steps(probe.plan, cells[refined], subset, probe.full_steps, cast),
                                      lambda f: 0.5 + 0.5 * f)
         again = np.isfinite(exact_all).all(axis=0) & np.isfinite(full_values[:, refined]).all(axis=0)
         floor[:, refined[again]] = (np.clip(full_values[:, refined[again]], 0.0, 1.0)
@@ -278,21 +281,19 @@ def floor_steps(probe: FloorProbe, sample: FloorSample, directions: int, exact_c
 
 
 def _exact_steps(plan: BakePlan, cells: np.ndarray, receivers: tuple[Receivers, Receivers],
-                 steps: tuple[np.ndarray, np.ndarray] | np.ndarray) -> Generator[float, None, np.ndarray]:
-    """(2, n) the CPU reference's value at `cells` (n,) from each replicate's receivers along
-    its `steps` (direction indices of plan's directions), NaN where unlit. Yields progress."""
+                 steps: tuple[np.ndarray, np.ndarray] | np.ndarray, cast: DistanceCast | None
+                 ) -> Generator[float, None, np.ndarray]:
+    """(2, n) the reference's value at `cells` (n,) from each replicate's receivers along its
+    `steps` (direction indices of plan's directions), NaN where unlit: exact rays, a
+    replicate's cast together by `cast` where given. Yields progress."""
     from .core.bake.reference_baker import ReferenceBaker  # deferred: mathutils comes with bpy
     plan = plan.with_cells(cells)
     exact = np.full((2, len(cells)), np.nan)
-    total = sum(len(part) for part in steps)
-    done = 0
     for k in range(2):
         baker = ReferenceBaker(plan, receivers[k], START_OFFSET_PIXELS * plan.pixel_size)
         try:
-            for index in steps[k]:
-                baker.run_direction(int(index))
-                done += 1
-                yield done / total
+            baker.run_directions(np.asarray(steps[k]), cast)
+            yield (k + 1) / 2
             numerator, w = (part.reshape(-1)[cells] for part in plan.estimator.ratio(baker.accumulated()))
         finally:
             baker.free()

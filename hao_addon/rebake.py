@@ -253,7 +253,8 @@ def _receiver_bounds(plan, spheres: np.ndarray, settings: BakeSettings) -> np.nd
     receivers = plan.receivers()
     world = receivers.points * plan.scale + plan.centre
     args = (settings.weighting, settings.spread_angle, settings.max_distance)
-    bound = sampled_change_bound(world, receivers.shading, spheres, plan.directions, *args)
+    bound = sampled_change_bound(world, receivers.shading, spheres, plan.directions, *args,
+                                 direction_class=plan.direction_class)
     return cell_bound(bound, receivers.texel, int(np.prod(plan.layout.output_shape)))
 
 
@@ -269,7 +270,8 @@ def _piece_bounds(plan, spheres: np.ndarray, settings: BakeSettings, threshold: 
 
     def bound_of(pieces: np.ndarray, corner_normals: np.ndarray) -> np.ndarray:
         unit = corner_normals / np.maximum(np.linalg.norm(corner_normals, axis=2, keepdims=True), 1e-30)
-        return sampled_change_bound(pieces[:, :3], unit, spheres, plan.directions, *args, reach=pieces[:, 3])
+        return sampled_change_bound(pieces[:, :3], unit, spheres, plan.directions, *args, reach=pieces[:, 3],
+                                    direction_class=plan.direction_class)
 
     uvs, bound = refined_piece_bounds(world, plan.target_uvs[lit].astype(np.float64), normals, bound_of, threshold,
                                       max(PIECE_SHARE * float(spheres[:, 3].min()), 0.5 * texel))

@@ -116,6 +116,9 @@ class _EntrySums:
     sums_b: np.ndarray
     directions_a: np.ndarray
     directions_b: np.ndarray
+    # (m,) the texel class each of those directions serves (core/bake/interleave.py)
+    classes_a: np.ndarray
+    classes_b: np.ndarray
 
 
 def _entry_sums_steps(plan: BakePlan) -> Generator[float, None, tuple[_EntrySums, dict] | None]:
@@ -139,23 +142,29 @@ def _entry_sums_steps(plan: BakePlan) -> Generator[float, None, tuple[_EntrySums
         state_b = baker.entry_state()
         stats = dict(baker.stats)
         order = plan.directions[baker.direction_order]
+        served = baker.served_classes(baker.direction_order)
     finally:
         baker.free()
     if state_b is None:
         return None
     sums_a = None if state_a is None else state_a[1].astype(np.float64)
-    return _EntrySums(state_b[0], sums_a, state_b[1].astype(np.float64), order[:split], order[split:]), stats
+    return _EntrySums(state_b[0], sums_a, state_b[1].astype(np.float64), order[:split], order[split:],
+                       served[:split], served[split:]), stats
 
 
-def _entry_weights(receivers, directions: np.ndarray, settings: BakeSettings) -> np.ndarray:
-    """(n,) each receiver's W over directions (m, 3): the weight the bake gives each direction
-    whatever it sees (the gather's VIEW_WEIGHT times the receiver's scale), which the skipped
-    blocks of a cropped view never add (entry_blocks.py)."""
+def _entry_weights(receivers, directions: np.ndarray, settings: BakeSettings, receiver_class: np.ndarray,
+                   direction_class: np.ndarray) -> np.ndarray:
+    """(n,) each receiver's W over directions (m, 3) of its texel class (receiver_class (n,),
+    direction_class (m,)): the weight the bake gives each direction whatever it sees (the
+    gather's VIEW_WEIGHT times the receiver's scale), which the skipped blocks of a cropped
+    view never add (entry_blocks.py)."""
     total = np.zeros(len(receivers.points))
-    rows = max(1, (1 << 20) // max(1, len(directions)))
-    for first in range(0, len(total), rows):
-        cos = receivers.shading[first:first + rows] @ directions.T
-        total[first:first + rows] = hemisphere_weight(cos, settings.weighting, settings.spread_cos).sum(axis=1)
+    for texel_class in np.unique(receiver_class):
+        at, own = np.flatnonzero(receiver_class == texel_class), directions[direction_class == texel_class]
+        rows = max(1, (1 << 20) // max(1, len(own)))
+        for first in range(0, len(at), rows):
+            cos = receivers.shading[at[first:first + rows]] @ own.T
+            total[at[first:first + rows]] = hemisphere_weight(cos, settings.weighting, settings.spread_cos).sum(axis=1)
     return total * receivers.inv_s
 
 
@@ -166,10 +175,11 @@ def _texel_difference(entries: _EntrySums, stats: dict, plan: BakePlan, cells: n
     some entry of which changed alone (W, a sum over every direction, is computed for their
     entries only)."""
     texel = np.searchsorted(cells, entries.receivers.texel)
-    replicates = [(sums, d) for sums, d in ((entries.sums_a, entries.directions_a),
-                                            (entries.sums_b, entries.directions_b)) if sums is not None]
+    replicates = [(sums, d, c) for sums, d, c in ((entries.sums_a, entries.directions_a, entries.classes_a),
+                                                  (entries.sums_b, entries.directions_b, entries.classes_b))
+                  if sums is not None]
     moved = np.zeros(len(texel), bool)
-    for sums, _ in replicates:
+    for sums, _d, _c in replicates:
         moved |= sums[:, 0] != 0.0
     changed = np.unique(texel[moved])
     marked = np.zeros(len(cells), bool)
@@ -177,8 +187,9 @@ def _texel_difference(entries: _EntrySums, stats: dict, plan: BakePlan, cells: n
     involved = marked[texel]
     receivers, at = entries.receivers.subset(involved), np.searchsorted(changed, texel[involved])
     parts = []
-    for sums, directions in replicates:
-        weight = _entry_weights(receivers, directions, plan.settings)
+    receiver_class = plan.receiver_classes(receivers.texel)
+    for sums, directions, direction_class in replicates:
+        weight = _entry_weights(receivers, directions, plan.settings, receiver_class, direction_class)
         lit = weight > 0.0
         change = np.divide(sums[involved, 0], weight, out=np.zeros(len(weight)), where=lit)
         parts.append((np.bincount(at, weights=change, minlength=len(changed)),

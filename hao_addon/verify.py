@@ -32,7 +32,7 @@ def verify_steps(target: BakeTarget, occluders: list[TriangleSoup], settings: Ba
     plan = yield from make_plan_steps(target, occluders, settings, run=run)  # a projection's rays yield progress too
     baker = ReferenceBaker(plan)
     try:
-        sums_a, sums_b = yield from replicate_sums_steps(baker, VERIFY_DIRECTIONS)
+        sums_a, sums_b = yield from replicate_sums_steps(baker, plan.direction_count)
     finally:
         baker.free()
     num_a, w_a = (part.reshape(-1)[cells] for part in plan.estimator.ratio(sums_a))

@@ -137,7 +137,7 @@ class VIEW3D_PT_hao_bake_quality(_BakeSubPanel, bpy.types.Panel):
         else:
             col.prop(settings, "directions", **({} if values.quality == "fixed" else {"text": "Max Directions"}))
         _active_column(col, values.quality in ("custom", "fixed")).prop(settings, "max_error")
-        _props(col, settings, "view_samples", "samples_per_texel", "seed")
+        _props(col, settings, "view_samples", "samples_per_texel", "texel_sets", "seed")
         checked = _active_column(col, target_kind(values.target).writes_images)  # texels of a UV layout
         checked.prop(settings, "verify")
         _active_column(checked, settings.verify > 0).prop(settings, "verify_max_error")

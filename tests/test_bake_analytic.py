@@ -218,7 +218,7 @@ def test_gather_batch_size_follows_the_depth_map_budget():
         settings = SimpleNamespace(max_distance=max_distance, directions=directions)
         return bake_gather.views_per_dispatch(SimpleNamespace(max_view_side=side, settings=settings,
                                                               layered=max_distance > 0.0, direction_count=directions,
-                                                              before_drawn=before_drawn))
+                                                              before_drawn=before_drawn, classes=1))
     assert [per_dispatch(s) for s in (256, 1024, 1448, 2048, 4096)] == [16, 16, 8, 4, 1]
     assert [per_dispatch(256, d) for d in (1, 8, 16, 20, 64, 96, 100)] == [1, 8, 16, 10, 16, 16, 15]
     assert per_dispatch(256, max_distance=1.0) == 1
@@ -298,12 +298,12 @@ def test_every_baker_returns_the_estimators_sums(gpu_context, method):
     assert plan.estimator is AMBIENT_OCCLUSION
     baker = baker_for(method)(plan)
     try:
-        split = replicate_sizes(settings.directions)[0]
+        split = replicate_sizes(plan.direction_count)[0]  # every texel class's directions
         for i in range(split):
             baker.run_direction(i)
         first = baker.accumulated()
         baker.restart()
-        for i in range(split, settings.directions):
+        for i in range(split, plan.direction_count):
             baker.run_direction(i)
         sums = first + baker.accumulated()
     finally:

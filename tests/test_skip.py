@@ -84,7 +84,7 @@ def test_closed_surfaces_skip_back_faces_in_depth_maps(gpu_context):
         for p in (plan, dataclasses.replace(plan, closed_surfaces=False)):
             baker = baker_for(method)(p)
             try:
-                for i in range(p.settings.directions):
+                for i in range(p.direction_count):
                     baker.run_direction(i)
                 maps.append(finalize_map(*baker.plan.estimator.ratio(baker.accumulated()), 0))
             finally:
@@ -125,7 +125,7 @@ def test_gather_draws_averted_faces_only_where_the_light_looks_into_a_hole(gpu_c
     for holes in (plan.holes, None, []):
         baker = baker_for("gather")(dataclasses.replace(plan, holes=holes))
         try:
-            for i in range(settings.directions):
+            for i in range(plan.direction_count):
                 baker.run_direction(i)
             maps.append(finalize_map(*baker.plan.estimator.ratio(baker.accumulated()), 0))
             stats.append(dict(baker.stats))

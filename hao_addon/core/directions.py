@@ -97,9 +97,51 @@ def probe_order(count: int) -> list[np.ndarray]:
     return [a + part for a, b in zip(starts[:-1], starts[1:]) for part in probe_first(int(b - a), half)]
 
 
+# The azimuth step, in turns, of the lattice whose points every 4th (one texel class of four)
+# are a spherical Fibonacci set: (golden ratio - 1 + j) / 4 makes each class's step the golden
+# one, and j sets the union's. Under a ball resting on a floor at 1024^2, 256 directions a
+# texel, the shadow's RMSE after an 8 x 8 box filter for j = 0..3: 0.0030, 0.0021, 0.0017,
+# 0.0022 (each texel's own RMSE 0.0070 for all; four independently rotated sets: 0.0026; one set
+# for all texels: 0.0052). A numpy model of the gather, bench/structured_error_bench.py.
+CLASS_LATTICE_STEP = {4: ((np.sqrt(5.0) - 1.0) / 2.0 + 2.0) / 4.0}
+
+
+def lattice_sphere(count: int, step: float) -> np.ndarray:
+    """(count, 3) points z_i = 1 - (2 i + 1) / count, azimuth i * step turns: equal area per
+    point, as fibonacci_sphere, whose step is the golden one."""
+    i = np.arange(count, dtype=np.float64)
+    z = 1.0 - (2.0 * i + 1.0) / count
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, 1.0))
+    phi = 2.0 * np.pi * np.mod(i * step, 1.0)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def class_directions(count: int, seed: int, classes: int) -> tuple[np.ndarray, np.ndarray]:
+    """The baker's direction set for `count` directions per texel and `classes` texel classes
+    (core/bake/interleave.py; 1 or a key of CLASS_LATTICE_STEP): REPLICATES lattices
+    (lattice_sphere) of classes x count / REPLICATES points, each with its own random rotation
+    (bake_directions' for one class), every classes-th point of a lattice serving one class:
+    each class gets a spherical Fibonacci set of its own, and what a few neighbouring texels
+    see together is the whole lattice. In the second replicate the classes' points are shifted
+    by classes / 2, so that with an odd count every class sees count directions.
+
+    Returns ((classes * count, 3) float64 unit vectors pointing from the surface towards the
+    sky, in replicate order (replicate_sizes(classes * count)), and (classes * count,) int the
+    class each serves)."""
+    if classes == 1:
+        return bake_directions(count, seed), np.zeros(count, np.int64)
+    if classes not in CLASS_LATTICE_STEP or count < 2:
+        raise ValueError(f"texel classes are 1 or {sorted(CLASS_LATTICE_STEP)} with 2 directions or more, "
+                         f"got {classes} and {count}")
+    sizes = replicate_sizes(classes * count)
+    points = [lattice_sphere(n, CLASS_LATTICE_STEP[classes]) @ random_rotation(seed, r).T for r, n in enumerate(sizes)]
+    served = [(np.arange(n) + r * (classes // 2)) % classes for r, n in enumerate(sizes)]
+    return np.concatenate(points), np.concatenate(served)
+
+
 def bake_directions(count: int, seed: int = 0) -> np.ndarray:
-    """The baker's direction set: REPLICATES spherical Fibonacci sets, each with its own
-    random rotation (replicate_sizes, one after the other).
+    """The baker's direction set without texel classes: REPLICATES spherical Fibonacci sets,
+    each with its own random rotation (replicate_sizes, one after the other).
 
     Returns (count, 3) float64 unit vectors pointing from the surface towards the sky.
     """

@@ -29,6 +29,7 @@ import gpu
 import numpy as np
 
 from ..core.bake.entry_blocks import block_runs, intersected_runs
+from ..core.bake.interleave import class_pixel_scale
 from ..core.bake.face_chunks import (boxes_meeting_windows, face_chunks, hole_chunk_ranges_many,
                                       window_chunk_ranges_many)
 from ..core.bake.normal_bins import (BIN_COUNT, FaceBins, bin_cones, bin_runs, bins_facing, cell_cones,
@@ -84,10 +85,15 @@ def views_per_dispatch(plan: BakePlan) -> int:
     assert VIEWS_PER_DISPATCH <= GATHER_MAX_VIEWS
     if plan.layered:
         return 1
-    most = int(np.clip(DEPTH_BATCH_BYTES // (4 * plan.max_view_side**2), 1, VIEWS_PER_DISPATCH))
+    # With texel classes (core/bake/interleave.py) as many as the views would be without them:
+    # their coarser views would fit more, but a class's directions lie further apart, and a
+    # batch of them faces more bins (the floor under a ball, 1024^2: 3 a dispatch 4.6 s, 15
+    # 5.1 s; Spot: 8 5.4 s, 16 6.2 s, as without classes).
+    side = plan.max_view_side * class_pixel_scale(plan.classes)
+    most = int(np.clip(DEPTH_BATCH_BYTES // (4 * side**2), 1, VIEWS_PER_DISPATCH))
     if plan.before_drawn is not None:  # a re-bake by difference: each direction's maps before and after
         return 2 * max(1, most // 2)
-    directions = max(1, plan.direction_count)
+    directions = max(1, plan.direction_count // plan.classes)  # a dispatch's views serve one texel class
     batches = math.ceil(directions / most)
     return math.ceil(directions / batches)
 
@@ -132,13 +138,17 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
                               for depth in self.depths]
         self.pending: list = []  # views rendered into depths[:len(pending)], not yet tested
         self.pending_signs: list[float] = []  # each pending view's: -1 the scene before an edit
+        self.pending_class = 0  # the texel class the pending views serve (core/bake/interleave.py)
         # GatherViews: one buffer per bake, rewritten before each dispatch.
         self.views_data = np.zeros(1, GATHER_VIEWS_DTYPE)
         self.views_block = gpu.types.GPUUniformBuf(self.views_data.view(np.float32))
         # Batches of nearby directions face nearly the same normal bins (core/bake/normal_bins.py),
         # each replicate in its own order, one after the other (they are accumulated apart), its
         # floor probe's directions first (core/directions.probe_order).
-        self.direction_order = np.concatenate([part[proximity_order(plan.directions[part])]
+        # With texel classes (core/bake/interleave.py) a part's directions go class by class:
+        # a dispatch tests one class's entries against its views.
+        self.direction_order = np.concatenate([part[np.lexsort((np.argsort(proximity_order(plan.directions[part])),
+                                                                self.served_classes(part)))]
                                                for part in probe_order(len(plan.directions))])
         # Uploaded entries always hold both normals (_upload_texel_list).
         self.shading_layout = self.plan.smooth_shading or self.receivers is not None
@@ -214,18 +224,25 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
                                 for (index, _), run in zip(cropped, runs)}
             self._before_fitted([index for index, _ in cropped], [v for _, v in cropped])
 
-    def _entry_runs(self, omegas: np.ndarray) -> list[tuple[int, int]]:
-        """(first entry, end entry) runs of the bins that can face one of omegas (k, 3)."""
+    def served_classes(self, directions: np.ndarray) -> np.ndarray:
+        """(k,) the texel class that directions (k,) (indices into plan.directions) serve."""
+        plan = self.plan
+        return np.zeros(len(directions), np.int64) if plan.classes == 1 else plan.direction_class[directions]
+
+    def _entry_runs(self, omegas: np.ndarray, texel_class: int = 0) -> list[tuple[int, int]]:
+        """(first entry, end entry) runs of the bins of `texel_class` that can face one of
+        omegas (k, 3)."""
         if NORMAL_BINNING:
             needed = bins_facing(self.bin_axis, self.bin_threshold, omegas)
         else:
             needed = np.ones(BIN_COUNT, bool)
-        return bin_runs(needed, self.bin_first)
+        first = BIN_COUNT * texel_class
+        return bin_runs(needed, self.bin_first[first:first + BIN_COUNT + 1])
 
     def _tested_runs(self, views: list) -> list[tuple[int, int]]:
         """(first entry, end entry) runs a dispatch of views tests: of the bins that can face
         one of them, and of views cropped to spheres only the blocks their windows reach."""
-        runs = self._entry_runs(np.array([view.omega for view in views]))
+        runs = self._entry_runs(np.array([view.omega for view in views]), self.pending_class)
         if self.entry_blocks is None:
             return runs
         meets = boxes_meeting_windows(self.entry_blocks, *window_arrays(views))
@@ -293,6 +310,10 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
 
     def run_direction(self, index: int) -> None:
         plan = self.plan
+        texel_class = int(self.served_classes(self.direction_order[index:index + 1])[0])
+        if self.pending and texel_class != self.pending_class:  # a dispatch tests one class's entries
+            self._test_pending_views()
+        self.pending_class = texel_class
         view = self.view(index)
         with util.scoped_state():
             gpu.state.blend_set('NONE')
@@ -405,8 +426,10 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
             gpu.compute.dispatch(shader, groups_x, -(-count // LIST_WIDTH), 1)
             tested += count
         gpu.shader.unbind()
+        first = BIN_COUNT * self.pending_class  # the entries of the views' texel class
+        entries = int(self.bin_first[first + BIN_COUNT] - self.bin_first[first])
         self.stats["texel_tests"] += tested * len(views)
-        self.stats["texel_tests_skipped"] += (self.entry_count - tested) * len(views)
+        self.stats["texel_tests_skipped"] += (entries - tested) * len(views)
 
     def accumulated(self) -> np.ndarray:
         """(*plan.output_shape, channels) float64: the estimator's sums, the entries summed per

@@ -134,3 +134,27 @@ def project_steps(origins: np.ndarray, directions: np.ndarray, triangles: np.nda
     hit = face >= 0
     bary[hit] = barycentric_from_uv(uv[hit])
     return face, bary
+
+
+def first_hit_distances(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray, reach: float
+                        ) -> np.ndarray:
+    """The distance to each ray's first hit (origins, unit directions (m, 3)) on triangles
+    (F, 3, 3), either side, within reach; inf for none: mathutils' BVH ray cast of
+    core/reference.first_hits for a batch of rays at once (core/bake/reference_baker.py's
+    run_directions: a contact's or a floor check's rays along every direction, one dispatch
+    per RAYS_PER_DISPATCH of them and one read-back instead of a Python call per ray)."""
+    distances = np.full(len(origins), np.inf)
+    if len(origins) == 0 or len(triangles) == 0:
+        return distances
+    grid = build_grid(np.asarray(triangles, np.float64))
+    cast = GpuRayCast(grid, origins, directions)
+    try:
+        with util.scoped_state():
+            for first in range(0, len(origins), RAYS_PER_DISPATCH):
+                cast.dispatch(first, min(first + RAYS_PER_DISPATCH, len(origins)), min(reach / grid.cell, 3.0e38))
+        out = cast.form.read(cast.hit, cast.ray_count)
+    finally:
+        cast.free()
+    hit = out[:, 0].copy().view(np.int32) >= 0
+    distances[hit] = out[hit, 1].astype(np.float64) * grid.cell
+    return distances

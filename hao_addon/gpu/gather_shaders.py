@@ -9,7 +9,8 @@ import gpu
 import numpy as np
 
 from ..core.bake.estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
-from ..core.bake.normal_bins import OCT_SIDE
+from ..core.bake.interleave import SIDE
+from ..core.bake.normal_bins import BIN_COUNT, OCT_SIDE
 from ..core.bake.terminator import MIN_LIFT
 from ..core.bake.uv_raster import SAMPLE_INSET
 from . import util
@@ -27,8 +28,8 @@ FACE_ATTRIBUTES = ("tri_v0", "tri_v1", "tri_v2", "corner_bary")
 LIFT_ATTRIBUTES = ("tri_n0", "tri_n1", "tri_n2")
 
 
-def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.GPUShaderCreateInfo":
-    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}{int(shading)}{int(terminator)}")
+def _texel_list_info(fill: bool, shading: bool, terminator: bool, side: int) -> "gpu.types.GPUShaderCreateInfo":
+    iface = gpu.types.GPUStageInterfaceInfo(f"hao_texel_list_iface_{int(fill)}{int(shading)}{int(terminator)}{side}")
     iface.smooth('VEC3', "world_pos")
     iface.smooth('VEC4', "face_data")
     iface.flat('VEC3', "geometric_normal")
@@ -40,6 +41,9 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
     info.vertex_in(3, 'FLOAT', "bin")
     info.vertex_in(4, 'VEC3', "geometric")
     info.define("SAMPLE_INSET", f"{SAMPLE_INSET:.9g}")
+    if side > 1:  # texel classes (core/bake/interleave.py): each class's bins after the one before's
+        info.define("INTERLEAVE_SIDE", str(side))
+        info.define("BIN_COUNT", str(BIN_COUNT))
     for k, name in enumerate(FACE_ATTRIBUTES):
         info.vertex_in(5 + k, 'VEC3', name)
         if name == "corner_bary":
@@ -74,12 +78,14 @@ def _texel_list_info(fill: bool, shading: bool, terminator: bool) -> "gpu.types.
 
 
 @shader_variants(valid=lambda a: a["shading"] or not a["terminator"],
-                 fill=(False, True), shading=(False, True), terminator=(False, True))
-def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = False) -> "gpu.types.GPUShader":
+                 fill=(False, True), shading=(False, True), terminator=(False, True), side=(1, SIDE))
+def texel_list_shader(fill: bool, shading: bool = False, terminator: bool = False, side: int = 1
+                      ) -> "gpu.types.GPUShader":
     """shading: entries carry the shading and the face normal (plan.smooth_shading);
-    terminator: and their terminator lift (plan.lifts_terminator)."""
-    return cached_shader(("bake_texel_list", fill, shading, terminator),
-                         lambda: _texel_list_info(fill, shading, terminator))
+    terminator: and their terminator lift (plan.lifts_terminator); side: of the texel classes'
+    pattern (core/bake/interleave.py; 1: none)."""
+    return cached_shader(("bake_texel_list", fill, shading, terminator, side),
+                         lambda: _texel_list_info(fill, shading, terminator, side))
 
 
 # The light views of one gather dispatch: the GatherViews uniform block, whose GLSL struct is

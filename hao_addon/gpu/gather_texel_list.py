@@ -11,6 +11,7 @@ import gpu
 import numpy as np
 
 from ..core.bake.entry_blocks import block_boxes, block_order
+from ..core.bake.interleave import SIDE
 from ..core.bake.normal_bins import BIN_COUNT, bin_cones, normal_bins, octahedral_coords, octahedral_decode
 from ..core.bake.plan import BakePlan
 from ..core.bake.receivers import Receivers, faces_touching
@@ -39,7 +40,14 @@ def faces_reaching_cells(plan: BakePlan) -> BakePlan:
 
 class TexelList:
     """The texel-list part of GatherBaker (its plan, target_batch, receivers, lifted and
-    the list textures are the baker's)."""
+    the list textures are the baker's). The list is stored bin by bin: the normal bins
+    (core/bake/normal_bins.py) of texel class 0, then those of class 1 and on
+    (core/bake/interleave.py)."""
+
+    @property
+    def list_bins(self) -> int:
+        """The list's bins: BIN_COUNT per texel class."""
+        return BIN_COUNT * self.plan.classes
 
     def _allocate_list(self, count: int, uploaded: tuple[np.ndarray, ...] | None = None) -> None:
         """The list textures for `count` entries (LIST_WIDTH per row) and zeroed sums;
@@ -76,11 +84,13 @@ class TexelList:
         """The list from CPU receivers: sorted by the normal bin of their shading normal (the
         one their weight is about), both normals octahedral-encoded (the SHADING_NORMALS layout)."""
         receivers = receivers.subset(receivers.inv_s > 0.0)
-        bins = normal_bins(receivers.shading)
+        normal_bin = normal_bins(receivers.shading)
+        bins = normal_bin + BIN_COUNT * self.plan.receiver_classes(receivers.texel)  # each class's bins apart
         order = np.argsort(bins, kind="stable")
         bins = bins[order]
-        self.bin_axis, self.bin_threshold = bin_cones(receivers.shading[order], bins, np.ones(len(bins), bool))
-        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=BIN_COUNT))]).astype(np.int64)
+        self.bin_axis, self.bin_threshold = bin_cones(receivers.shading[order], normal_bin[order],
+                                                      np.ones(len(bins), bool))
+        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=self.list_bins))]).astype(np.int64)
         position = np.concatenate([receivers.points[order], receivers.inv_s[order, None]], axis=1)
         normal = np.concatenate([octahedral_coords(receivers.shading[order]),
                                  octahedral_coords(receivers.geometric[order])], axis=1)
@@ -98,8 +108,8 @@ class TexelList:
         if self.receivers is not None:
             self._upload_texel_list(self.receivers)
             return
-        size = self.plan.settings.size
-        counter = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32UI')
+        size, bins = self.plan.settings.size, self.list_bins
+        counter = gpu.types.GPUTexture((bins, 1), format='R32UI')
         uv_target = gpu.types.GPUTexture((size, size), format='R8')
         uv_fb = gpu.types.GPUFrameBuffer(color_slots=uv_target)
 
@@ -120,20 +130,20 @@ class TexelList:
                 self.target_batch.draw(shader)
             util.image_barrier()
 
-        fill = texel_list_shader(True, self.plan.smooth_shading, self.lifted)
-        draw(texel_list_shader(False, self.plan.smooth_shading, self.lifted))
-        per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
+        side = SIDE if self.plan.classes > 1 else 1
+        fill = texel_list_shader(True, self.plan.smooth_shading, self.lifted, side)
+        draw(texel_list_shader(False, self.plan.smooth_shading, self.lifted, side))
+        per_bin = util.texture_to_numpy(counter, np.uint32).ravel()[:bins].astype(np.int64)
         count = int(per_bin.sum())
         self.bin_first = np.concatenate([[0], np.cumsum(per_bin)])  # (BIN_COUNT + 1,) range bounds
         self._allocate_list(count)
         # Only FLOAT buffers upload: the uint32 starts travel as float bits (floatBitsToUint).
         starts = self.bin_first[:-1].astype(np.uint32).view(np.float32)
-        bin_start = gpu.types.GPUTexture((BIN_COUNT, 1), format='R32F',
-                                         data=gpu.types.Buffer('FLOAT', BIN_COUNT, starts))
+        bin_start = gpu.types.GPUTexture((bins, 1), format='R32F', data=gpu.types.Buffer('FLOAT', bins, starts))
         draw(fill)
         # Both passes bin each fragment by the same arithmetic on the same inputs; a GPU whose
         # two variants rounded a shading normal differently would have filled a neighbour's range.
-        filled = util.texture_to_numpy(counter, np.uint32).ravel()[:BIN_COUNT].astype(np.int64)
+        filled = util.texture_to_numpy(counter, np.uint32).ravel()[:bins].astype(np.int64)
         if not np.array_equal(filled, per_bin):
             raise RuntimeError(f"the texel list's fill pass binned {int(np.abs(filled - per_bin).sum())} entries "
                                f"differently from its count pass")
@@ -157,7 +167,7 @@ class TexelList:
             ends = uploaded[0][:, :3] + (uploaded[2][:, :3] if self.lifted else 0.0)  # a test's point: up to the lift
             self.entry_blocks = block_boxes(np.minimum(uploaded[0][:, :3], ends).astype(np.float64),
                                             np.maximum(uploaded[0][:, :3], ends).astype(np.float64))
-        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=BIN_COUNT))]).astype(np.int64)
+        self.bin_first = np.concatenate([[0], np.cumsum(np.bincount(bins, minlength=self.list_bins))]).astype(np.int64)
         self._allocate_list(len(keep), uploaded)
         self.entry_cells = flat[keep]
 

@@ -56,7 +56,9 @@ class BakerDeclaration:
     receiver outside reading lit: a re-bake by difference (hao_addon/rebake_difference.py).
     traces_contacts: its visibility test misses occluders nearer than its depth slack, so the
     receivers in contact with another surface (core/bake/contacts.py) are traced exactly
-    (hao_addon/contact_repair.py)."""
+    (hao_addon/contact_repair.py). interleaves: it can bake neighbouring texels with
+    differently rotated direction sets (core/bake/interleave.py), so that the map's error is
+    grain, not the polygons of one set's shadows."""
 
     method: str
     label: str
@@ -67,6 +69,7 @@ class BakerDeclaration:
     floor_unchecked: str = ""
     crops_views: bool = False
     traces_contacts: bool = False
+    interleaves: bool = False
 
     def can(self, ability: str) -> bool:
         return ability not in self.cannot
@@ -86,10 +89,10 @@ BAKERS = (
                 "color-attribute": "it rasterizes the UV layout"},
         bakes_all_cells="it splats every texel its target's triangles cover in each light view"),
     BakerDeclaration(
-        "gather", "shadow-map gather", gpu=True, crops_views=True, traces_contacts=True,
+        "gather", "shadow-map gather", gpu=True, crops_views=True, traces_contacts=True, interleaves=True,
         cannot={"thickness": "from inside a closed surface its max-distance depth lists miss part of the nearest "
                              "walls: 0.006 too thin on a ball, measured by tests/test_thickness.py"}),
-    BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False,
+    BakerDeclaration("reference", "reference (CPU ray tracing)", gpu=False, interleaves=True,
                      floor_unchecked="its visibility is exact: rays against the triangles"),
 )
 BAKE_METHODS = tuple(b.method for b in BAKERS)

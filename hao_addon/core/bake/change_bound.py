@@ -73,7 +73,7 @@ def change_bound(points: np.ndarray, spheres: np.ndarray, weighting: str = "cosi
 
 def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.ndarray, directions: np.ndarray,
                          weighting: str = "cosine", spread_angle: float = 90.0, max_distance: float = 0.0,
-                         reach: np.ndarray | None = None) -> np.ndarray:
+                         reach: np.ndarray | None = None, direction_class: np.ndarray | None = None) -> np.ndarray:
     """(n,) float64: the most a bake's own estimate can change at each receiver: the weight
     share of its directions (D, 3) that point into a changed sphere. The estimate is the mean
     over its replicates (core/directions.replicate_sizes: consecutive runs of the directions)
@@ -82,7 +82,9 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
     many directions is not bounded by change_bound's share of the whole hemisphere (a
     direction that falls into a small cone moves it by about 1 / D). normals: (n, 3) the
     receivers' shading normals, or (n, m, 3) several each (a face's corners: each direction
-    weighs its most over them, each sum its least); reach: as change_bound's."""
+    weighs its most over them, each sum its least); reach: as change_bound's; direction_class:
+    (D,) the texel class each direction serves (core/bake/interleave.py): a receiver sees its
+    class's alone, and the bound is the largest over the classes."""
     from ..directions import replicate_sizes
     from .normalization import hemisphere_weight
 
@@ -93,7 +95,10 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
     directions = np.asarray(directions, np.float64).reshape(-1, 3)
     spread_cos = 0.0 if spread_angle >= 90.0 else float(np.cos(np.radians(spread_angle)))
     sizes = np.cumsum([0, *replicate_sizes(len(directions))])
-    runs = list(zip(sizes[:-1], sizes[1:]))  # each replicate's directions
+    served = np.zeros(len(directions), np.int64) if direction_class is None else np.asarray(direction_class)
+    # each class's directions in each replicate
+    runs = [[first + np.flatnonzero(served[first:end] == k) for first, end in zip(sizes[:-1], sizes[1:])]
+            for k in np.unique(served)]
     if normals.shape[1] > 1 and (normals == normals[:, :1]).all():
         normals = normals[:, :1]  # flat faces: one normal does for every corner
     bound = np.zeros(len(points))
@@ -118,9 +123,12 @@ def sampled_change_bound(points: np.ndarray, normals: np.ndarray, spheres: np.nd
         weights = hemisphere_weight(normals[start + hit] @ directions.T, weighting, spread_cos)  # (h, m, D)
         hits = weights.max(axis=1) * inside[hit]
         share = np.zeros(len(hit))
-        for first, end in runs:
-            total = np.maximum(weights[..., first:end].sum(axis=2).min(axis=1), 1e-300)
-            share += hits[:, first:end].sum(axis=1) / (total * len(runs))
+        for replicates in runs:
+            of_class = np.zeros(len(hit))
+            for own in replicates:
+                total = np.maximum(weights[..., own].sum(axis=2).min(axis=1), 1e-300)
+                of_class += hits[:, own].sum(axis=1) / (total * len(replicates))
+            share = np.maximum(share, of_class)
         bound[start + hit] = np.minimum(share, 1.0)
     return bound
 

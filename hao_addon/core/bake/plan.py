@@ -12,14 +12,15 @@ from typing import Callable, Generator
 
 import numpy as np
 
-from ..directions import bake_directions
+from ..directions import class_directions
 from ..errors import BakeInputError
-from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, corner_shading_normals, face_normals_areas,
-                        surface_holes, unusable_normal_warnings, uv_areas, weld)
+from ..geometry import (TriangleSoup, bounding_sphere, column_bounds, face_normals_areas, surface_holes,
+                        unusable_normal_warnings, uv_areas, weld)
 from .abilities import abilities_needed, check_method, choose_method, declaration
 from .alpha import DrawnAlpha, drawn_alpha
 from .estimators import AMBIENT_OCCLUSION, BENT_NORMALS, Estimator
-from .normalization import corner_normalizers, face_normalizers
+from .interleave import class_pixel_scale, classes_for, texel_classes
+from .plan_weights import inverse_normalizers, shading_corners
 from ..steps import drain
 from .projection import HighToLow, RayCast, check_high_to_low
 from .receivers import Receivers, faces_touching
@@ -58,11 +59,11 @@ class BakePlan:
     # exact normalizer of n_s (0 on faces never lit); face normal and 1 / S_f on flat faces.
     target_corners: np.ndarray
     # (Ft, 3) float32: the part of each corner's S that lies above its face (directions the
-    # true surface can see), as a fraction; 1 on flat faces. See _shading_corners.
+    # true surface can see), as a fraction; 1 on flat faces. See plan_weights.shading_corners.
     target_above: np.ndarray
     occluder_positions: np.ndarray  # (Fo, 3, 3) float32 normalized
     occluder_normals: np.ndarray    # (Fo, 3) float32
-    directions: np.ndarray        # (D, 3) float64
+    directions: np.ndarray        # (D, 3) float64: every texel class's (core/bake/interleave.py)
     pixel_size: float             # light-view pixel side, normalized units
     max_view_side: int
     target_points: np.ndarray     # (n, 3) float64 normalized, for fitting views
@@ -92,6 +93,10 @@ class BakePlan:
     stats: dict = field(default_factory=dict)
     # What lets light through, per drawn face (core/bake/alpha.py), or None: all opaque.
     alpha: DrawnAlpha | None = None
+    # (D,) int the texel class each direction serves (core/bake/interleave.py), and how many
+    # classes there are (1: every direction serves every receiver).
+    direction_class: np.ndarray | None = None
+    classes: int = 1
 
     @property
     def kind(self) -> TargetKind:
@@ -121,7 +126,19 @@ class BakePlan:
 
     @property
     def direction_count(self) -> int:
+        """Directions drawn: those of every texel class."""
         return len(self.directions)
+
+    @property
+    def texel_directions(self) -> int:
+        """Directions each receiver sees (the bake's Directions: direction_count over classes)."""
+        return len(self.directions) // self.classes
+
+    def receiver_classes(self, texels: np.ndarray) -> np.ndarray:
+        """(n,) int the class of receivers at flat texels (n,) (all 0 without classes)."""
+        if self.classes == 1:
+            return np.zeros(len(texels), np.int64)
+        return texel_classes(texels, self.settings.size)
 
     def receivers(self) -> Receivers:
         """The bake's receivers (its layout's: the projected high-poly points, the target's
@@ -290,22 +307,21 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
     if cast is None and cast_for is not None and bake_target.high_to_low is not None:
         cast = cast_for(method)
     centre, scale, t_pos = _normalized(target)
-    directions = bake_directions(run.directions, run.seed)
     # The kind's own steps (a Selected-to-Active projection casts its rays here).
     layout = yield from LAYOUTS[kind.name].made(bake_target, settings, udim, centre, scale, cast, projection)
     flat = np.concatenate([target.positions.reshape(-1, 3), layout.receiver_points() * scale + centre])
     o_pos, alpha_parts, culling = _drawn_occluders(occluders, flat, settings, kind, target, centre, scale)
     o_normals, _ = face_normals_areas(o_pos)
-    inv_s = _inverse_normalizers(normals, areas, directions, settings)
-    corners, above, smooth_corners = _shading_corners(target, normals, inv_s, directions, settings)
+    alpha, sized_for = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip), method
+    method, classes, directions, direction_class = _method_directions(settings, run, kind, udim, layout, method, alpha)
+    inv_s = inverse_normalizers(normals, areas, directions, settings)
+    corners, above, smooth_corners = shading_corners(target, normals, inv_s, directions, settings)
     extent = layout.extent  # (over every projected point: once)
-    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, method, extent)
+    pixel_size, dense_fraction = light_pixel_size(settings, kind, udim, areas, uv_area, scale, sized_for, extent)
+    pixel_size *= class_pixel_scale(classes)
 
     drawn = np.concatenate(([t_pos.reshape(-1, 3)] if kind.target_occludes else []) + [o_pos.reshape(-1, 3)])
     target_weld = weld(t_pos.reshape(-1, 3))
-    alpha = drawn_alpha(alpha_parts, settings.alpha, settings.alpha_clip)
-    if alpha is not None:  # the bake needs occluders that let light through: Auto chooses again
-        method = choose_method(run.method, _needs(settings, run, kind, udim) | {"alpha"})
     holes = _drawn_holes(settings, alpha, drawn, target_weld if len(o_pos) == 0 else None)
     stats = _plan_stats(target, settings, areas, uv_area, len(o_pos), culling, pixel_size * scale, dense_fraction,
                         holes, smooth_corners, uv_warnings + layout.warnings + unusable_normal_warnings(
@@ -329,7 +345,7 @@ def make_plan_steps(target: TriangleSoup | BakeTarget, occluders: list[TriangleS
         - np.append(centre / scale, 0.0),
         drawn_sphere=bounding_sphere(drawn), needs_footprint_splat=dense_fraction > DENSE_AREA_LIMIT,
         smooth_shading=smooth_corners > 0 or layout.smooth_receivers, closed_surfaces=holes == [], holes=holes,
-        stats=stats, alpha=alpha)
+        stats=stats, alpha=alpha, direction_class=direction_class, classes=classes)
 
 
 def _face_normals_areas(target: TriangleSoup) -> tuple[np.ndarray, np.ndarray]:
@@ -370,12 +386,14 @@ def _needs(settings: BakeSettings, run: BakeRun, kind, udim: UdimLayout | None) 
                                         settings.min_distance, settings.spread_cos > 0.0)
 
 
-def _inverse_normalizers(normals: np.ndarray, areas: np.ndarray, directions: np.ndarray,
-                         settings: BakeSettings) -> np.ndarray:
-    """(F,) 1 / S_f of each face (face_normalizers); faces no direction sees, and zero-area
-    faces (no surface), contribute nothing: 0."""
-    s_f = face_normalizers(normals, directions, settings.weighting, spread_cos=settings.spread_cos)
-    return np.divide(1.0, s_f, out=np.zeros_like(s_f), where=(s_f > 0.0) & (areas > 0.0))
+def _method_directions(settings: BakeSettings, run: BakeRun, kind: TargetKind, udim, layout: TexelLayout,
+                       method: str, alpha: DrawnAlpha | None) -> tuple[str, int, np.ndarray, np.ndarray]:
+    """(the method that runs: Auto chooses again where occluders let light through, its
+    texel classes (core/bake/interleave.py), the directions (D, 3) and the class each serves (D,))."""
+    if alpha is not None:
+        method = choose_method(run.method, _needs(settings, run, kind, udim) | {"alpha"})
+    classes = classes_for(declaration(method).interleaves, layout.per_element, run.directions, settings.texel_sets)
+    return (method, classes, *class_directions(run.directions, run.seed, classes))
 
 
 def _drawn_holes(settings: BakeSettings, alpha, drawn: np.ndarray, welded) -> list | None:
@@ -462,35 +480,3 @@ def _plan_stats(target: TriangleSoup, settings: BakeSettings, areas: np.ndarray,
                 samples_per_texel=settings.sample_count, warnings=warnings,
                 alpha_faces=0 if alpha is None else int(((alpha.constant < 1.0) | (alpha.layer >= 0)).sum()),
                 **counters)
-
-
-def _shading_corners(target: TriangleSoup, normals: np.ndarray, inv_s: np.ndarray, directions: np.ndarray,
-                     settings: BakeSettings) -> tuple[np.ndarray, np.ndarray, int]:
-    """(Ft, 3, 4) float32 shading normal and 1 / S per corner (BakePlan.target_corners),
-    (Ft, 3) float32 fraction of S above the face (BakePlan.target_above), and the number of
-    corners whose shading normal differs from the face normal.
-
-    The passes interpolate these across a face. Each texel's map value is a ratio of sums
-    that carry the same weights (numerator / denominator), so an open texel is exactly its
-    above-face fraction whatever the interpolated 1 / S; S per corner only balances the faces
-    and corners a texel mixes.
-
-    The above-face fraction F = sum_d w_d [omega_d . n_f > 0] / sum_d w_d splits the
-    estimator exactly: sum_d w_d V_d / sum_d w_d = F * (sum over directions above the face of
-    w_d V_d / the same sum of w_d), since V_d = 0 below the face (the terminator). The scatter
-    rasterizes only faces turned towards the light and multiplies by F, instead of drawing
-    averted faces edge-on just to add their weight (which a light-view pixel grid samples
-    coarsely: 0.4 % bias, 3 % texel noise on a lone plane with 30-degree normals)."""
-    mesh = settings.normals == "mesh" and target.normals is not None
-    shading, differing = corner_shading_normals(target.positions, target.normals if mesh else None, normals)
-    out = np.empty((len(normals), 3, 4), np.float32)
-    if differing == 0:
-        out[..., :3] = normals[:, None, :]
-        out[..., 3] = inv_s[:, None]
-        return out, np.ones((len(normals), 3), np.float32), 0
-    s_c, above = corner_normalizers(shading, normals, directions, settings.weighting, spread_cos=settings.spread_cos)
-    lit = (s_c > 0.0) & (inv_s[:, None] > 0.0)
-    out[..., :3] = shading
-    out[..., 3] = np.divide(1.0, s_c, out=np.zeros_like(s_c), where=lit)
-    fraction = np.divide(above, s_c, out=np.zeros_like(s_c), where=lit)
-    return out, fraction.astype(np.float32), differing

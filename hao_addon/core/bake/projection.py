@@ -193,6 +193,9 @@ def barycentric_from_uv(uv: np.ndarray) -> np.ndarray:
 # a generator of progress fractions that returns (face, bary). bakers.ray_caster_for() gives
 # the GPU twin (gpu/bake_ray_cast.py) to the GPU bakers.
 RayCast = Callable[[np.ndarray, np.ndarray, np.ndarray, float], Generator[float, None, tuple[np.ndarray, np.ndarray]]]
+# A batch of rays' first hits (reference_baker.ReferenceBaker.run_directions): origins (m, 3),
+# unit directions (m, 3), triangles (F, 3, 3), reach -> (m,) distances, inf where none.
+DistanceCast = Callable[[np.ndarray, np.ndarray, np.ndarray, float], np.ndarray]
 
 
 def projected_receivers_steps(target: TriangleSoup, request: HighToLow, settings: BakeSettings,

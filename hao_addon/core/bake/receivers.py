@@ -2,7 +2,7 @@
 """Receivers: the surface points a bake estimates AO at, each with the texel it adds to.
 
 A map's value at a texel is the ratio of its receivers' summed (V w, w) terms (core/bake/plan.py,
-_shading_corners), so one bake design serves every kind of receiver:
+plan_weights.shading_corners), so one bake design serves every kind of receiver:
 - the texel centres of the target's UV layout (what the gather's GPU texel list holds),
 - stratified sub-texel points of it (anti-aliasing, samples_per_texel > 1),
 - points on high-poly sources that the low-poly's texels project to (core/bake/projection.py),

@@ -16,6 +16,8 @@ call per ray): for tests and for checking a GPU bake, never a silent substitute 
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from mathutils import Vector
 
@@ -27,7 +29,7 @@ from .plan import BakePlan
 from .terminator import lift_amount, lifted_starts
 from ..reference import build_bvh, first_hits, hits_along, ray_offset
 from .alpha import expected_visibility
-from .projection import barycentric
+from .projection import DistanceCast, barycentric
 from .receivers import Receivers
 
 # Rays one reference bake may trace (about 4 us each here): beyond this it would run for
@@ -44,8 +46,8 @@ class ReferenceBaker:
     def rays_needed(plan: BakePlan) -> int:
         """Rays of a whole bake at most (one per receiver and direction)."""
         if plan.cells is not None:
-            return len(plan.cells) * plan.settings.sample_count * plan.direction_count
-        return plan.layout.receiver_bound() * plan.direction_count
+            return len(plan.cells) * plan.settings.sample_count * plan.texel_directions
+        return plan.layout.receiver_bound() * plan.texel_directions
 
     @classmethod
     def check_limits(cls, plan: BakePlan) -> None:
@@ -67,6 +69,11 @@ class ReferenceBaker:
         receivers = plan.receivers() if receivers is None else receivers  # plan.cells' alone where it names them
         receivers = receivers.subset(receivers.inv_s > 0.0)
         self.texel = receivers.texel
+        # Each texel class's receivers (core/bake/interleave.py), or None: every direction serves all.
+        self.served = None
+        if plan.classes > 1:
+            receiver_class = plan.receiver_classes(self.texel)
+            self.served = [np.flatnonzero(receiver_class == k) for k in range(plan.classes)]
         self.points, self.shading, self.inv_s = receivers.points, receivers.shading, receivers.inv_s
         self.geometric = receivers.geometric
         scene = plan.drawn_positions.astype(np.float64)
@@ -76,7 +83,7 @@ class ReferenceBaker:
         flat = scene.reshape(-1, 3)
         radius = float(np.linalg.norm(flat.max(0) - flat.min(0))) / 2.0
         self.offsets = np.array([max(ray_offset(p, radius), min_offset) for p in self.points])
-        self.origins = [Vector(p) for p in self.points + self.geometric * self.offsets[:, None]]
+        self.origin_points = self.points + self.geometric * self.offsets[:, None]
         self.lift = receivers.lift
         self.estimator = plan.estimator
         self.sums = np.zeros((len(self.points), self.estimator.channel_count))
@@ -84,40 +91,86 @@ class ReferenceBaker:
                           directions_done=0, shading_normals=plan.smooth_shading)
 
     def run_direction(self, index: int) -> None:
-        """Trace direction `index` of the plan from every receiver and add its terms."""
+        """Trace direction `index` of the plan from every receiver it serves (with texel
+        classes, core/bake/interleave.py, those of its class) and add their terms."""
+        rays = self._rays(index)
+        self._add(rays, self._cpu_distances(rays))
+
+    def run_directions(self, indices: np.ndarray, cast: DistanceCast | None = None) -> None:
+        """run_direction of each of `indices`, their rays cast together by `cast` (origins
+        (m, 3), unit directions (m, 3), the scene's triangles (F, 3, 3), reach -> (m,) first-hit
+        distances, inf for none: gpu/bake_ray_cast.first_hit_distances) where the bake's rays
+        are plain ones (can_cast_together), else one direction after another on the CPU."""
+        if cast is None or not self.can_cast_together:
+            for index in indices:
+                self.run_direction(int(index))
+            return
+        batches = [self._rays(int(index)) for index in indices]
+        origins = np.concatenate([np.zeros((0, 3))] + [b.origins for b in batches])
+        aims = np.concatenate([np.zeros((0, 3))] + [np.broadcast_to(b.omega, b.origins.shape) for b in batches])
+        distances = cast(origins, aims, self.scene, self._reach())
+        ends = np.cumsum([0] + [len(b.origins) for b in batches])
+        for batch, first, end in zip(batches, ends[:-1], ends[1:]):
+            self._add(batch, distances[first:end])
+
+    @property
+    def can_cast_together(self) -> bool:
+        """Every ray is one first hit (no surface that lets light through, no back face or
+        near occluder to pass by): a batch of them is one cast."""
         settings = self.plan.settings
+        return self.plan.alpha is None and self.face_normals is None and settings.min_distance == 0.0
+
+    def _reach(self) -> float:
+        return self.plan.max_distance_normalized if self.plan.settings.max_distance > 0.0 else 1e30
+
+    def _rays(self, index: int) -> "_Rays":
+        """The rays of direction `index` from the receivers it serves: from each lit receiver
+        above its true surface, or from its terminator lift where that lifts it."""
+        settings = self.plan.settings
+        at = self.served[self.plan.direction_class[index]] if self.served is not None else slice(None)
         omega = self.plan.directions[index]
-        cos_shading = self.shading @ omega
-        weight = hemisphere_weight(cos_shading, settings.weighting, settings.spread_cos) * self.inv_s
-        cos_true = self.geometric @ omega
+        cos_shading = self.shading[at] @ omega
+        weight = hemisphere_weight(cos_shading, settings.weighting, settings.spread_cos) * self.inv_s[at]
+        cos_true = self.geometric[at] @ omega
         above = cos_true > 0.0
-        reach = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 1e30
-        dists = np.zeros(len(self.points))  # below the true surface: occluded
-        ray_cast = self.bvh.ray_cast
-        amount = None
         if self.lift is not None:
             amount = lift_amount(cos_shading, cos_true, settings.terminator_offset)
-            lifted = (weight > 0.0) & lifted_starts(amount, np.linalg.norm(self.lift, axis=1))
+            lifted = (weight > 0.0) & lifted_starts(amount, np.linalg.norm(self.lift[at], axis=1))
         else:
-            lifted = np.zeros(len(self.points), bool)
-        d_max = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 0.0
+            amount, lifted = None, np.zeros(len(weight), bool)
         plain, lifted_at = np.flatnonzero(above & (weight > 0.0) & ~lifted), np.flatnonzero(lifted)
-        starts = [(i, self.origins[i]) for i in plain]
-        starts += [(i, Vector(self.points[i] + self.lift[i] * amount[i])) for i in lifted_at]
-        if self.plan.alpha is None:
-            rays = np.concatenate([plain, lifted_at])
-            dists[rays] = first_hits(ray_cast, [origin for _i, origin in starts], omega, reach, self.offsets[rays],
-                                     self.face_normals, self.plan.min_distance_normalized)
+        starts = [self.origin_points[at][plain]]
+        if len(lifted_at):
+            starts.append(self.points[at][lifted_at] + self.lift[at][lifted_at] * amount[lifted_at, None])
+        return _Rays(at, omega, weight, above, lifted, np.concatenate([plain, lifted_at]), np.concatenate(starts),
+                     self.offsets[at])
+
+    def _cpu_distances(self, rays: "_Rays") -> np.ndarray | None:
+        """The rays' first-hit distances by the CPU's BVH; None where surfaces let light through
+        (their visibility is computed per ray in _add)."""
+        if self.plan.alpha is not None:
+            return None
+        origins = [Vector(p) for p in rays.origins]
+        return first_hits(self.bvh.ray_cast, origins, rays.omega, self._reach(), rays.offsets[rays.traced],
+                          self.face_normals, self.plan.min_distance_normalized)
+
+    def _add(self, rays: "_Rays", distances: np.ndarray | None) -> None:
+        """Add the terms of rays whose first hits lie at `distances` (None: trace each through
+        what lets light through)."""
+        settings = self.plan.settings
+        d_max = self.plan.max_distance_normalized if settings.max_distance > 0.0 else 0.0
+        dists = np.zeros(len(rays.weight))  # below the true surface: occluded
+        if distances is not None:
+            dists[rays.traced] = distances
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)
         else:  # every surface up to the first opaque one, each kept with its alpha (core/bake/alpha.py)
             visible = 1.0 - occlusion_weight(dists, d_max, settings.falloff)  # 0 below the surface
-            for i, origin in starts:
-                visible[i] = self._visible_through(origin, omega, reach, self.offsets[i], d_max)
-        self.sums += self.estimator.terms(weight, visible, omega)
-        traced = (above & (weight > 0.0)) | lifted
-        self.stats["rays_traced"] += int(traced.sum())
-        self.stats["rays_lifted"] += int(lifted.sum())
-        self.stats["rays_below_surface"] += int(((weight > 0.0) & ~above & ~lifted).sum())
+            for i, origin in zip(rays.traced, rays.origins):
+                visible[i] = self._visible_through(Vector(origin), rays.omega, self._reach(), rays.offsets[i], d_max)
+        self.sums[rays.at] += self.estimator.terms(rays.weight, visible, rays.omega)
+        self.stats["rays_traced"] += len(rays.traced)
+        self.stats["rays_lifted"] += int(rays.lifted.sum())
+        self.stats["rays_below_surface"] += int(((rays.weight > 0.0) & ~rays.above & ~rays.lifted).sum())
         self.stats["directions_done"] += 1
 
     def _visible_through(self, origin: Vector, omega: np.ndarray, reach: float, offset: float, d_max: float
@@ -148,3 +201,19 @@ class ReferenceBaker:
     def free(self) -> None:
         """Nothing on the GPU; drops the BVH."""
         self.bvh = None
+
+
+@dataclass
+class _Rays:
+    """One direction's rays from the receivers `at` it serves: omega (3,); weight, above,
+    lifted (k,) per receiver; traced (t,) which of them cast a ray, from origins (t, 3)
+    (normalized); offsets (k,) their self-intersection offsets."""
+
+    at: np.ndarray | slice
+    omega: np.ndarray
+    weight: np.ndarray
+    above: np.ndarray
+    lifted: np.ndarray
+    traced: np.ndarray
+    origins: np.ndarray
+    offsets: np.ndarray

@@ -73,6 +73,12 @@ SAMPLES_PER_TEXEL_CHOICES = (
     Choice(9, "9 Samples", "a 3 x 3 grid of points in each texel, averaged"),
     Choice(16, "16 Samples", "a 4 x 4 grid of points in each texel, averaged"),
 )
+TEXEL_SETS_CHOICES = (
+    Choice(1, "One", "every texel the same directions: each direction's shadow edge lies in the same place "
+                     "for all, and the error takes the shapes of those shadows"),
+    Choice(4, "2 x 2", "neighbouring texels take turns with four direction sets: fine grain instead of shadow "
+                       "shapes; four light views per direction, each at twice the pixel side"),
+)
 
 
 @dataclass(frozen=True)
@@ -123,6 +129,10 @@ class BakeSettings:
         description="stratified points per texel, averaged, for silhouettes, thin features and UV edges "
                     "(the scatter, which averages each texel's area already, takes that many times more "
                     "light-view pixels per texel)")
+    texel_sets: int = setting(
+        1, label="Texel Sets", noun="direction sets", choices=TEXEL_SETS_CHOICES,
+        description="direction sets that neighbouring texels take turns with (the gather and the reference; "
+                    "the scatter and colour attributes bake one)")
     cage_extrusion: float = setting(
         0.0, label="Cage Extrusion", minimum=0.0, soft_max=1.0, unit="scene units", subtype='DISTANCE',
         description="Selected to Active: how far each ray starts outside the low-poly, along its normals "
@@ -169,7 +179,8 @@ class BakeSettings:
     method: str = setting("auto", label="Method", choices=METHOD_CHOICES, description="GPU bake algorithm")
     view_samples: float = setting(
         2.0, label="View Samples", minimum=0.25, maximum=64.0, soft_max=8.0,
-        description="light-view pixels per texel (the scatter's sampling density): more is smoother and slower")
+        description="light-view pixels per texel (with Texel Sets 2 x 2, the gather's per 2 x 2 texels): "
+                    "more is smoother and slower")
     seed: int = setting(0, label="Seed", minimum=0, maximum=2**31 - 1, description="rotation of the direction set")
 
     def validated(self) -> "BakeSettings":
