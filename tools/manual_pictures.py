@@ -64,6 +64,9 @@ OPTIONS = [
     OptionPicture("anti-aliasing", "Anti-Aliasing 16", "16 samples per texel smooth the silhouettes' and UV "
                   "edges' stair steps (at 64^2, enlarged).", {"samples_per_texel": 16, "size": 64},
                   {"size": 64}),
+    OptionPicture("texel-sets", "Texel Sets 2 x 2", "Neighbouring texels take turns with four direction sets: "
+                  "under the body and in the creases the polygons of each direction's shadow become fine grain "
+                  "(plainer on a floor: How it works); four light views per direction.", {"texel_sets": 4}),
     OptionPicture("margin", "Margin 0", "Without a margin, filtering reads the background at UV island edges "
                   "(left: 16 texels, the default).", {"margin": 0}),
     OptionPicture("thickness", "Thickness", "Thickness (right) beside the AO: light where a wall is near in "
