@@ -90,7 +90,7 @@ def _traced_steps(plan: BakePlan, cells: np.ndarray, order: np.ndarray, count: i
                 baker.restart()
             baker.run_directions(steps, cast)
             yield (k + 1) / len(parts)
-            part.reshape(-1, channels)[cells] = baker.accumulated().reshape(-1, channels)[cells]
+            part.reshape(-1, channels)[cells] = baker.accumulated_at(cells)
     finally:
         baker.free()
     return dict(contact_texels=int(len(cells)), contact_rays=int(baker.stats["rays_traced"]))

@@ -294,7 +294,7 @@ def _exact_steps(plan: BakePlan, cells: np.ndarray, receivers: tuple[Receivers, 
         try:
             baker.run_directions(np.asarray(steps[k]), cast)
             yield (k + 1) / 2
-            numerator, w = (part.reshape(-1)[cells] for part in plan.estimator.ratio(baker.accumulated()))
+            numerator, w = plan.estimator.ratio(baker.accumulated_at(cells))
         finally:
             baker.free()
         lit = w > 0.0

@@ -489,3 +489,15 @@ def test_surface_holes_are_remembered_by_their_corners(monkeypatch):
     for k in range(geometry.HOLES_REMEMBERED):  # pushed out by others
         geometry.surface_holes(holed + k + 1.0)
     assert geometry.surface_holes(holed) == [] and len(found) == 2 + geometry.HOLES_REMEMBERED
+
+
+def test_texel_sums_at_some_cells_are_the_whole_maps_there():
+    from hao_addon.core.bake.estimators import texel_sums, texel_sums_at
+    rng = np.random.default_rng(4)
+    texel = rng.integers(0, 64, 500)
+    sums = rng.random((500, 3))
+    sums[::7, -1] = 0.0  # unlit receivers add nothing
+    cells = np.array([0, 3, 17, 40, 63])
+    whole = texel_sums(texel, sums, (8, 8)).reshape(-1, 3)
+    np.testing.assert_allclose(texel_sums_at(texel, sums, cells), whole[cells], rtol=1e-12)
+    assert texel_sums_at(texel, sums, np.zeros(0, np.int64)).shape == (0, 3)

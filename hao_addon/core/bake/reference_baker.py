@@ -23,7 +23,7 @@ from mathutils import Vector
 
 from ..errors import BakeInputError
 from ..kernels import occlusion_weight
-from .estimators import texel_sums
+from .estimators import texel_sums, texel_sums_at
 from .normalization import hemisphere_weight
 from .plan import BakePlan
 from .terminator import lift_amount, lifted_starts
@@ -193,6 +193,10 @@ class ReferenceBaker:
     def accumulated(self) -> np.ndarray:
         """(*plan.output_shape, channels) float64: the estimator's sums per texel (or element)."""
         return texel_sums(self.texel, self.sums, self.plan.output_shape)
+
+    def accumulated_at(self, cells: np.ndarray) -> np.ndarray:
+        """(k, channels) float64: accumulated() at the sorted flat cells (k,) alone."""
+        return texel_sums_at(self.texel, self.sums, np.asarray(cells, np.int64))
 
     def restart(self) -> None:
         """Zero the sums (after accumulated()): the next directions are summed apart."""
