@@ -267,7 +267,8 @@ def _bake_uncached(target: BakeTarget, occluders: list[TriangleSoup], settings: 
         raise BakeInputError(f"'{target.name}': no texel centre of the {settings.size}x{settings.size} map lies "
                              f"inside its UV triangles (they lie outside the 0..1 tile, or are smaller than a "
                              f"texel): nothing to bake; check its UV map")
-    stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "covered_texels": int(covered.sum()),
+    stats = {**plan.stats, **cast_stats, **gpu_stats, "method": method, "texel_sets": plan.classes,
+             "covered_texels": int(covered.sum()),
              "cache_hit": False, "error": None if error is None else error.as_dict()}
     return BakeResult(ao, covered, filled, stats, bent, plan.layout.tiles, twin, error, method)
 

@@ -69,7 +69,7 @@ def test_object_token_and_json_report(dirs):
     assert data["input"] == str(SPOT) and data["outputs"] == [str(out / "spot_ao.exr")]
     assert data["objects"] == [dict(name="spot", triangles=5856, uv_map="UVMap", uv_map_created=False,
                                     covered_texels=data["objects"][0]["covered_texels"], method="gather",
-                                    smooth_corners=data["objects"][0]["smooth_corners"], instanced_occluders=0,
+                                    texel_sets=1, smooth_corners=data["objects"][0]["smooth_corners"], instanced_occluders=0,
                                     error=data["objects"][0]["error"])]
     assert data["objects"][0]["smooth_corners"] >= 0.99 * 3 * 5856  # 's 1': the sample is shaded smooth
     assert data["objects"][0]["error"]["directions"] == 8 and not data["objects"][0]["error"]["capped"]

@@ -112,6 +112,9 @@ def test_the_reference_twin_bakes_each_texel_from_its_own_set(gpu_context):
     reference = bake(floor, [ball], replace(settings, method="reference"), use_cache=False)
     one = bake(floor, [ball], replace(settings, texel_sets=1), use_cache=False)
     assert gather.stats["directions_done"] == CLASSES * 16 and one.stats["directions_done"] == 16
+    assert gather.stats["texel_sets"] == reference.stats["texel_sets"] == CLASSES and one.stats["texel_sets"] == 1
+    scatter = bake(floor, [ball], replace(settings, method="scatter", size=32), use_cache=False)
+    assert scatter.stats["texel_sets"] == 1 and scatter.stats["directions_done"] == 16  # it bakes one set
     shadow = gather.ao < 0.99
 
     def rms(a, b):

@@ -226,8 +226,7 @@ class GatherBaker(TexelList, SceneBefore, LightViewBaker):
 
     def served_classes(self, directions: np.ndarray) -> np.ndarray:
         """(k,) the texel class that directions (k,) (indices into plan.directions) serve."""
-        plan = self.plan
-        return np.zeros(len(directions), np.int64) if plan.classes == 1 else plan.direction_class[directions]
+        return self.plan.direction_class[directions]
 
     def _entry_runs(self, omegas: np.ndarray, texel_class: int = 0) -> list[tuple[int, int]]:
         """(first entry, end entry) runs of the bins of `texel_class` that can face one of

@@ -133,15 +133,15 @@ class ReferenceBaker:
         weight = hemisphere_weight(cos_shading, settings.weighting, settings.spread_cos) * self.inv_s[at]
         cos_true = self.geometric[at] @ omega
         above = cos_true > 0.0
+        lifted = np.zeros(len(weight), bool)
         if self.lift is not None:
+            lift = self.lift[at]
             amount = lift_amount(cos_shading, cos_true, settings.terminator_offset)
-            lifted = (weight > 0.0) & lifted_starts(amount, np.linalg.norm(self.lift[at], axis=1))
-        else:
-            amount, lifted = None, np.zeros(len(weight), bool)
+            lifted = (weight > 0.0) & lifted_starts(amount, np.linalg.norm(lift, axis=1))
         plain, lifted_at = np.flatnonzero(above & (weight > 0.0) & ~lifted), np.flatnonzero(lifted)
         starts = [self.origin_points[at][plain]]
         if len(lifted_at):
-            starts.append(self.points[at][lifted_at] + self.lift[at][lifted_at] * amount[lifted_at, None])
+            starts.append(self.points[at][lifted_at] + lift[lifted_at] * amount[lifted_at, None])
         return _Rays(at, omega, weight, above, lifted, np.concatenate([plain, lifted_at]), np.concatenate(starts),
                      self.offsets[at])
 
